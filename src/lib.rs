@@ -1,0 +1,21 @@
+//! # slidebase
+//!
+//! How a building on a sliding (friction) base responds to earthquakes, computed with
+//! Discontinuous Deformation Analysis (DDA) and checked against the exact solution of the
+//! classic mass-spring sliding model.
+//!
+//! The crate is laid out as a picture of its architecture:
+//!
+//! - [`ground_motion`]: harmonic input and recorded accelerograms (AT2/CSV readers).
+//! - `model`: scenes as data: blocks, materials, contacts, joints, supports, excitation.
+//! - `dda`: the solver: block matrices, contacts with Coulomb friction and the open-close
+//!   iteration, bolts and connection elements, integrators, energy bookkeeping.
+//! - `analytic`: the paper's mass-spring models, solved exactly (event-driven).
+//! - `post`: time histories, metrics, spectra and plots.
+//!
+//! The engine never depends on rendering; the visualizer lives behind the `gui` feature.
+
+pub mod error;
+pub mod ground_motion;
+
+pub use error::{Error, Result};
