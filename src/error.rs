@@ -100,7 +100,10 @@ pub fn require_positive(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be a finite number > 0, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be a finite number > 0, got {value}"),
+        ))
     }
 }
 
@@ -109,6 +112,9 @@ pub fn require_non_negative(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(Error::invalid(field, format!("must be a finite number >= 0, got {value}")))
+        Err(Error::invalid(
+            field,
+            format!("must be a finite number >= 0, got {value}"),
+        ))
     }
 }

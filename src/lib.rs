@@ -15,7 +15,9 @@
 //!
 //! The engine never depends on rendering; the visualizer lives behind the `gui` feature.
 
+pub mod dda;
 pub mod error;
 pub mod ground_motion;
+pub mod model;
 
 pub use error::{Error, Result};

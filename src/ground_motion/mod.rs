@@ -146,7 +146,10 @@ mod tests {
 
     #[test]
     fn harmonic_integrals_match_finite_differences() {
-        let h = Harmonic { amplitude: 2.9, omega: 3.7 };
+        let h = Harmonic {
+            amplitude: 2.9,
+            omega: 3.7,
+        };
         for &t in &[1e-4, 0.01, 0.3, 2.0, 17.5] {
             let e = 1e-5;
             let dv = (h.velocity(t + e) - h.velocity(t - e)) / (2.0 * e);

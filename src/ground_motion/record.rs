@@ -30,7 +30,11 @@ impl Record {
     pub fn new(name: impl Into<String>, dt: f64, accel: Vec<f64>) -> Result<Self> {
         let name = name.into();
         if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::parse(&name, 0, format!("time step must be > 0, got {dt}")));
+            return Err(Error::parse(
+                &name,
+                0,
+                format!("time step must be > 0, got {dt}"),
+            ));
         }
         if accel.is_empty() {
             return Err(Error::parse(&name, 0, "record has no samples"));
@@ -141,7 +145,9 @@ impl Record {
     /// Largest |a| over samples with t ≤ `until`, m/s².
     pub fn peak_accel(&self, until: f64) -> f64 {
         let last = ((until / self.dt).floor() as usize).min(self.accel.len() - 1);
-        self.accel[..=last].iter().fold(0.0_f64, |m, a| m.max(a.abs()))
+        self.accel[..=last]
+            .iter()
+            .fold(0.0_f64, |m, a| m.max(a.abs()))
     }
 
     /// Sample times strictly inside `(t0, t1)`.

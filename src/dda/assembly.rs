@@ -1,0 +1,217 @@
+//! The global system of one step: assembly of 6×6 blocks and its solution.
+//!
+//! Unknowns are numbered per free block (6 each); a prescribed block's increment is known
+//! and its couplings move to the right-hand side. Two primitives cover every term:
+//! a *scalar spring* `½k q² + f0 q` with `q = a·D_i + b·D_j` (contact normal and shear
+//! springs), and a *nodal element* whose nodes are points carried by blocks
+//! (bolts, fixed points, connection elements).
+
+use nalgebra::{DMatrix, DVector};
+
+use super::block::{Mat6, Vec6, t_matrix};
+use crate::model::geometry::Point;
+use crate::{Error, Result};
+
+/// Maps blocks to unknowns and holds the known increments of prescribed blocks.
+#[derive(Debug, Clone)]
+pub struct DofMap {
+    /// For each block, the index of its first unknown, or `None` when prescribed.
+    pub slot: Vec<Option<usize>>,
+    /// Number of unknowns.
+    pub n: usize,
+}
+
+impl DofMap {
+    /// Numbers the free blocks in order.
+    pub fn new(is_free: &[bool]) -> Self {
+        let mut n = 0;
+        let slot = is_free
+            .iter()
+            .map(|&f| {
+                if f {
+                    n += 6;
+                    Some(n - 6)
+                } else {
+                    None
+                }
+            })
+            .collect();
+        Self { slot, n }
+    }
+}
+
+/// A linear system `K D = R` under assembly.
+#[derive(Debug, Clone)]
+pub struct System {
+    /// Effective stiffness.
+    pub k: DMatrix<f64>,
+    /// Right-hand side.
+    pub r: DVector<f64>,
+    /// Factor multiplying stiffness terms: 1 − αf (1 for the static solve).
+    pub stiffness_factor: f64,
+}
+
+impl System {
+    /// An all-zero system of size n.
+    pub fn zeros(n: usize, stiffness_factor: f64) -> Self {
+        Self {
+            k: DMatrix::zeros(n, n),
+            r: DVector::zeros(n),
+            stiffness_factor,
+        }
+    }
+
+    /// Adds `scale · m` to the diagonal block of the unknowns starting at `s`.
+    pub fn add_diag_block(&mut self, s: usize, m: &Mat6, scale: f64) {
+        for i in 0..6 {
+            for j in 0..6 {
+                self.k[(s + i, s + j)] += scale * m[i][j];
+            }
+        }
+    }
+
+    /// Adds `v` to the right-hand side of the unknowns starting at `s`.
+    pub fn add_rhs(&mut self, s: usize, v: &Vec6, scale: f64) {
+        for i in 0..6 {
+            self.r[s + i] += scale * v[i];
+        }
+    }
+
+    /// Scalar spring `½k q² + f0 q` with `q = a·D_i + b·D_j` (b/j optional).
+    /// `known` gives the increments of all blocks (used for prescribed ones).
+    pub fn add_scalar_spring(
+        &mut self,
+        dofs: &DofMap,
+        known: &[Vec6],
+        k: f64,
+        f0: f64,
+        (bi, a): (usize, &Vec6),
+        other: Option<(usize, &Vec6)>,
+    ) {
+        let c = self.stiffness_factor * k;
+        let parts: [Option<(usize, &Vec6)>; 2] = [Some((bi, a)), other];
+        for part in parts.iter() {
+            let Some((bp, vp)) = *part else { continue };
+            let Some(sp) = dofs.slot[bp] else { continue };
+            for i in 0..6 {
+                self.r[sp + i] -= f0 * vp[i];
+            }
+            for qpart in parts.iter() {
+                let Some((bq, vq)) = *qpart else { continue };
+                match dofs.slot[bq] {
+                    Some(sq) => {
+                        for i in 0..6 {
+                            let ci = c * vp[i];
+                            if ci == 0.0 {
+                                continue;
+                            }
+                            for j in 0..6 {
+                                self.k[(sp + i, sq + j)] += ci * vq[j];
+                            }
+                        }
+                    }
+                    None => {
+                        // Known increment: the coupling goes to the right-hand side.
+                        let q_known: f64 = (0..6).map(|j| vq[j] * known[bq][j]).sum();
+                        for i in 0..6 {
+                            self.r[sp + i] -= c * vp[i] * q_known;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Nodal element: nodes are points `x_k` of blocks `b_k`; the element has stiffness
+    /// `ke` (2n×2n, row-major, on node displacements) and start-of-step force `fe` (2n).
+    pub fn add_nodal_element(
+        &mut self,
+        dofs: &DofMap,
+        known: &[Vec6],
+        centroids: &[Point],
+        nodes: &[(usize, Point)],
+        ke: &[f64],
+        fe: &[f64],
+    ) {
+        let n = nodes.len();
+        let dim = 2 * n;
+        let ts: Vec<[[f64; 6]; 2]> = nodes
+            .iter()
+            .map(|&(b, x)| t_matrix(centroids[b], x))
+            .collect();
+        let c = self.stiffness_factor;
+        for (k, &(bk, _)) in nodes.iter().enumerate() {
+            let Some(sk) = dofs.slot[bk] else { continue };
+            let tk = &ts[k];
+            // Start-of-step force.
+            for i in 0..6 {
+                self.r[sk + i] -= tk[0][i] * fe[2 * k] + tk[1][i] * fe[2 * k + 1];
+            }
+            for (l, &(bl, _)) in nodes.iter().enumerate() {
+                let tl = &ts[l];
+                // 2×2 sub-block of ke between nodes k and l.
+                let sub = [
+                    [ke[(2 * k) * dim + 2 * l], ke[(2 * k) * dim + 2 * l + 1]],
+                    [
+                        ke[(2 * k + 1) * dim + 2 * l],
+                        ke[(2 * k + 1) * dim + 2 * l + 1],
+                    ],
+                ];
+                // m = T_kᵀ sub T_l (6×6).
+                let mut m = [[0.0; 6]; 6];
+                for i in 0..6 {
+                    let a0 = tk[0][i] * sub[0][0] + tk[1][i] * sub[1][0];
+                    let a1 = tk[0][i] * sub[0][1] + tk[1][i] * sub[1][1];
+                    if a0 == 0.0 && a1 == 0.0 {
+                        continue;
+                    }
+                    for j in 0..6 {
+                        m[i][j] = a0 * tl[0][j] + a1 * tl[1][j];
+                    }
+                }
+                match dofs.slot[bl] {
+                    Some(sl) => {
+                        for i in 0..6 {
+                            for j in 0..6 {
+                                self.k[(sk + i, sl + j)] += c * m[i][j];
+                            }
+                        }
+                    }
+                    None => {
+                        for i in 0..6 {
+                            let s: f64 = (0..6).map(|j| m[i][j] * known[bl][j]).sum();
+                            self.r[sk + i] -= c * s;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Solves the system (Cholesky: the effective stiffness is symmetric positive definite).
+    pub fn solve(self, time: f64) -> Result<DVector<f64>> {
+        let System { k, r, .. } = self;
+        if r.iter().any(|v| !v.is_finite()) || k.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Solver {
+                time,
+                reason: "the system contains a non-finite value (NaN/inf); check material \
+                         constants, penalties and the time step"
+                    .into(),
+            });
+        }
+        match k.cholesky() {
+            Some(ch) => Ok(ch.solve(&r)),
+            None => Err(Error::Solver {
+                time,
+                reason: "the system matrix is not positive definite: a block is unsupported \
+                         or a penalty/material constant is negative or far too large"
+                    .into(),
+            }),
+        }
+    }
+}
+
+/// Displacement of node `x` of block `b` given all blocks' increments.
+pub fn node_displacement(centroids: &[Point], increments: &[Vec6], b: usize, x: Point) -> Point {
+    super::block::point_displacement(centroids[b], x, &increments[b])
+}

@@ -1,0 +1,315 @@
+//! Joints between blocks and supports: bolts, fixed points/rollers, connection elements.
+//!
+//! Each is a *nodal element*: its nodes are points carried by blocks (moving with `T·D`),
+//! it has a stiffness on the node displacements and a force from what it carried at the
+//! start of the step. The assembly maps both onto the blocks' unknowns.
+
+use super::block::Vec6;
+use crate::model::geometry::{Point, sub};
+use crate::model::scene::{BoltKind, FixedDirection};
+
+/// A node displacement function: block index and point → displacement this step.
+pub trait NodeMotion {
+    /// Displacement of point `x` of block `b` in this step.
+    fn node_displacement(&self, b: usize, x: Point) -> Point;
+}
+
+/// Stiffness, start force and energy of a nodal element for one step.
+#[derive(Debug, Clone, Default)]
+pub struct ElementTerms {
+    /// Nodes: (block, current position).
+    pub nodes: Vec<(usize, Point)>,
+    /// Stiffness on node displacements, 2n × 2n row-major.
+    pub ke: Vec<f64>,
+    /// Node forces at the step start (∂E/∂u), 2n.
+    pub fe: Vec<f64>,
+}
+
+impl ElementTerms {
+    /// Node forces at the end of the step: fe + ke·u.
+    pub fn end_forces(&self, u: &[Point]) -> Vec<f64> {
+        let dim = self.fe.len();
+        (0..dim)
+            .map(|i| {
+                self.fe[i]
+                    + (0..dim)
+                        .map(|j| self.ke[i * dim + j] * u[j / 2][j % 2])
+                        .sum::<f64>()
+            })
+            .collect()
+    }
+}
+
+/// A bolt between point P of block i and point Q of block j (paper eq. 5).
+#[derive(Debug, Clone)]
+pub struct Bolt {
+    /// Name from the scene.
+    pub name: String,
+    /// Blocks (i, j).
+    pub blocks: [usize; 2],
+    /// Current end points.
+    pub points: [Point; 2],
+    /// Q − P in the unstressed configuration.
+    pub rest: Point,
+    /// Spring constant, N/m.
+    pub stiffness: f64,
+    /// Two-component or axial.
+    pub kind: BoltKind,
+}
+
+impl Bolt {
+    /// Elongation vector (Q − P) − rest.
+    pub fn elongation(&self) -> Point {
+        let d = sub(self.points[1], self.points[0]);
+        sub(d, self.rest)
+    }
+
+    /// Force the bolt exerts on its Q end, N (equal and opposite on P).
+    pub fn force_on_q(&self) -> Point {
+        match self.kind {
+            BoltKind::TwoComponent => {
+                let e = self.elongation();
+                [-self.stiffness * e[0], -self.stiffness * e[1]]
+            }
+            BoltKind::Axial => {
+                let d = sub(self.points[1], self.points[0]);
+                let l = d[0].hypot(d[1]);
+                let l0 = self.rest[0].hypot(self.rest[1]);
+                let f = self.stiffness * (l - l0);
+                [-f * d[0] / l, -f * d[1] / l]
+            }
+        }
+    }
+
+    /// Element terms for this step.
+    pub fn terms(&self) -> ElementTerms {
+        let k = self.stiffness;
+        // Stiffness pattern [[S, −S], [−S, S]] for a 2×2 S.
+        let pattern = |s: [[f64; 2]; 2]| {
+            let mut ke = vec![0.0; 16];
+            for (a, sa) in [(0usize, 1.0), (1usize, -1.0)] {
+                for (b, sb) in [(0usize, 1.0), (1usize, -1.0)] {
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            ke[(2 * a + i) * 4 + 2 * b + j] = sa * sb * s[i][j];
+                        }
+                    }
+                }
+            }
+            ke
+        };
+        // fe = ∂E/∂u, ordered (P, Q): the bolt pulls Q with `f` and P with −f, and
+        // ∂E/∂u is minus the force the bolt exerts on the node.
+        let f = self.force_on_q();
+        let fe = vec![f[0], f[1], -f[0], -f[1]];
+        let ke = match self.kind {
+            BoltKind::TwoComponent => pattern([[k, 0.0], [0.0, k]]),
+            BoltKind::Axial => {
+                let d = sub(self.points[1], self.points[0]);
+                let l = d[0].hypot(d[1]).max(f64::MIN_POSITIVE);
+                let u = [d[0] / l, d[1] / l];
+                let l0 = self.rest[0].hypot(self.rest[1]);
+                // Material stiffness k·uuᵀ plus the geometric stiffness of a bolt under
+                // tension N: (N/l)(I − uuᵀ).
+                let g = k * (l - l0) / l;
+                let mut s = [[0.0; 2]; 2];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let id = if i == j { 1.0 } else { 0.0 };
+                        s[i][j] = k * u[i] * u[j] + g * (id - u[i] * u[j]);
+                    }
+                }
+                pattern(s)
+            }
+        };
+        ElementTerms {
+            nodes: vec![
+                (self.blocks[0], self.points[0]),
+                (self.blocks[1], self.points[1]),
+            ],
+            ke,
+            fe,
+        }
+    }
+
+    /// Stored energy, J.
+    pub fn energy(&self) -> f64 {
+        match self.kind {
+            BoltKind::TwoComponent => {
+                let e = self.elongation();
+                0.5 * self.stiffness * (e[0] * e[0] + e[1] * e[1])
+            }
+            BoltKind::Axial => {
+                let d = sub(self.points[1], self.points[0]);
+                let e = d[0].hypot(d[1]) - self.rest[0].hypot(self.rest[1]);
+                0.5 * self.stiffness * e * e
+            }
+        }
+    }
+
+    /// Moves the end points with their blocks.
+    pub fn commit(&mut self, motion: &impl NodeMotion) {
+        for (p, &b) in self.points.iter_mut().zip(self.blocks.iter()) {
+            let u = motion.node_displacement(b, *p);
+            p[0] += u[0];
+            p[1] += u[1];
+        }
+    }
+}
+
+/// A point of a block held near its anchor by a penalty spring (pin or roller).
+#[derive(Debug, Clone)]
+pub struct FixedPoint {
+    /// The block.
+    pub block: usize,
+    /// The point's current position.
+    pub point: Point,
+    /// Where it is held.
+    pub anchor: Point,
+    /// Pin or roller.
+    pub direction: FixedDirection,
+    /// Penalty, N/m.
+    pub penalty: f64,
+}
+
+impl FixedPoint {
+    fn projector(&self) -> [[f64; 2]; 2] {
+        match self.direction {
+            FixedDirection::Both => [[1.0, 0.0], [0.0, 1.0]],
+            FixedDirection::X => [[1.0, 0.0], [0.0, 0.0]],
+            FixedDirection::Y => [[0.0, 0.0], [0.0, 1.0]],
+        }
+    }
+
+    /// Element terms for this step.
+    pub fn terms(&self) -> ElementTerms {
+        let p = self.projector();
+        let c = sub(self.point, self.anchor);
+        let ke = vec![
+            self.penalty * p[0][0],
+            self.penalty * p[0][1],
+            self.penalty * p[1][0],
+            self.penalty * p[1][1],
+        ];
+        let fe = vec![
+            self.penalty * (p[0][0] * c[0] + p[0][1] * c[1]),
+            self.penalty * (p[1][0] * c[0] + p[1][1] * c[1]),
+        ];
+        ElementTerms {
+            nodes: vec![(self.block, self.point)],
+            ke,
+            fe,
+        }
+    }
+
+    /// Stored energy, J.
+    pub fn energy(&self) -> f64 {
+        let p = self.projector();
+        let c = sub(self.point, self.anchor);
+        let pc = [
+            p[0][0] * c[0] + p[0][1] * c[1],
+            p[1][0] * c[0] + p[1][1] * c[1],
+        ];
+        0.5 * self.penalty * (pc[0] * c[0] + pc[1] * c[1])
+    }
+
+    /// Moves the point with its block.
+    pub fn commit(&mut self, motion: &impl NodeMotion) {
+        let u = motion.node_displacement(self.block, self.point);
+        self.point[0] += u[0];
+        self.point[1] += u[1];
+    }
+}
+
+/// A constant-strain triangle whose nodes move with their blocks (paper eqs. 6–7).
+#[derive(Debug, Clone)]
+pub struct Connection {
+    /// Blocks carrying the three nodes.
+    pub blocks: [usize; 3],
+    /// Current node positions (counter-clockwise).
+    pub nodes: [Point; 3],
+    /// Elasticity matrix C, Pa.
+    pub elasticity: [[f64; 3]; 3],
+    /// Accumulated strain (εx, εy, γxy).
+    pub strain: [f64; 3],
+    /// Accumulated stress, Pa.
+    pub stress: [f64; 3],
+}
+
+impl Connection {
+    /// Area and strain-displacement matrix B (3×6) of the current triangle.
+    fn b_matrix(&self) -> (f64, [[f64; 6]; 3]) {
+        let [p1, p2, p3] = self.nodes;
+        let two_a = (p2[0] - p1[0]) * (p3[1] - p1[1]) - (p3[0] - p1[0]) * (p2[1] - p1[1]);
+        let b = [p2[1] - p3[1], p3[1] - p1[1], p1[1] - p2[1]];
+        let c = [p3[0] - p2[0], p1[0] - p3[0], p2[0] - p1[0]];
+        let mut m = [[0.0; 6]; 3];
+        for k in 0..3 {
+            m[0][2 * k] = b[k] / two_a;
+            m[1][2 * k + 1] = c[k] / two_a;
+            m[2][2 * k] = c[k] / two_a;
+            m[2][2 * k + 1] = b[k] / two_a;
+        }
+        (two_a / 2.0, m)
+    }
+
+    /// Element terms: `ke = A Bᵀ C B`, `fe = A Bᵀ σ`.
+    pub fn terms(&self) -> ElementTerms {
+        let (area, b) = self.b_matrix();
+        let c = &self.elasticity;
+        let mut cb = [[0.0; 6]; 3];
+        for i in 0..3 {
+            for j in 0..6 {
+                cb[i][j] = (0..3).map(|k| c[i][k] * b[k][j]).sum();
+            }
+        }
+        let mut ke = vec![0.0; 36];
+        let mut fe = vec![0.0; 6];
+        for i in 0..6 {
+            fe[i] = area * (0..3).map(|k| b[k][i] * self.stress[k]).sum::<f64>();
+            for j in 0..6 {
+                ke[i * 6 + j] = area * (0..3).map(|k| b[k][i] * cb[k][j]).sum::<f64>();
+            }
+        }
+        ElementTerms {
+            nodes: (0..3).map(|k| (self.blocks[k], self.nodes[k])).collect(),
+            ke,
+            fe,
+        }
+    }
+
+    /// Strain energy ½ A εᵀ C ε, J.
+    pub fn energy(&self) -> f64 {
+        let (area, _) = self.b_matrix();
+        let e = &self.strain;
+        let c = &self.elasticity;
+        let mut w = 0.0;
+        for i in 0..3 {
+            for j in 0..3 {
+                w += e[i] * c[i][j] * e[j];
+            }
+        }
+        0.5 * area * w
+    }
+
+    /// Accumulates strain and stress from this step's node displacements and moves the nodes.
+    pub fn commit(&mut self, motion: &impl NodeMotion) {
+        let (_, b) = self.b_matrix();
+        let u: Vec<Point> = (0..3)
+            .map(|k| motion.node_displacement(self.blocks[k], self.nodes[k]))
+            .collect();
+        let flat: Vec6 = [u[0][0], u[0][1], u[1][0], u[1][1], u[2][0], u[2][1]];
+        let mut de = [0.0; 3];
+        for i in 0..3 {
+            de[i] = (0..6).map(|j| b[i][j] * flat[j]).sum();
+        }
+        for i in 0..3 {
+            self.strain[i] += de[i];
+            self.stress[i] += (0..3).map(|j| self.elasticity[i][j] * de[j]).sum::<f64>();
+        }
+        for (p, d) in self.nodes.iter_mut().zip(u.iter()) {
+            p[0] += d[0];
+            p[1] += d[1];
+        }
+    }
+}

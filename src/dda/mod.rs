@@ -1,0 +1,21 @@
+//! Discontinuous Deformation Analysis: the solver.
+//!
+//! Each block has six unknowns at its centroid (translation, rotation, three strains).
+//! A step assembles inertia (through the time integrator), block elasticity, joints and
+//! the contact penalty springs into one symmetric positive definite system, solves it,
+//! re-judges every contact (open / locked / sliding) and repeats until no state changes
+//! (the open-close iteration), cutting Δt when it does not settle. See
+//! `dda-theory.md` for the equations.
+
+pub mod assembly;
+pub mod block;
+pub mod contact;
+pub mod energy;
+pub mod joints;
+pub mod judge;
+pub mod params;
+pub mod solver;
+
+pub use energy::EnergyTerms;
+pub use params::{Integrator, SolverParams};
+pub use solver::{Dda, RunCounters, StepReport};

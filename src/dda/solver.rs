@@ -1,0 +1,986 @@
+//! The DDA time step: assembly, the open-close iteration, Δt control and the commit.
+
+use std::collections::HashMap;
+
+use nalgebra::DVector;
+use serde::Serialize;
+
+use super::assembly::{DofMap, System};
+use super::block::{
+    Block, BlockRole, Vec6, point_displacement, point_displacement_exact_rotation,
+    t_transpose_times,
+};
+use super::contact::{self, Contact, ContactKey, ContactMemory, ContactPair, JointProps, dot6};
+use super::energy::EnergyTerms;
+use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
+use super::judge::{ContactState, JudgeInput, judge};
+use super::params::{AlphaCoefficients, SolverParams};
+use crate::ground_motion::GroundMotion;
+use crate::model::geometry::{self, Point};
+use crate::model::scene::{FixedDirection, GroundKind, Scene};
+use crate::{Error, Result};
+
+/// A constant point load carried by a block.
+#[derive(Debug, Clone)]
+struct PointLoad {
+    block: usize,
+    point: Point,
+    force: Point,
+}
+
+/// What happened in one accepted step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StepReport {
+    /// Time at the end of the step, s.
+    pub time: f64,
+    /// Step size actually used, s.
+    pub dt: f64,
+    /// Open-close passes in the accepted attempt.
+    pub passes: usize,
+    /// Δt cuts before the step was accepted.
+    pub cuts: usize,
+    /// Contacts found by the search.
+    pub contacts: usize,
+    /// Closed contacts.
+    pub closed: usize,
+    /// Sliding contacts.
+    pub sliding: usize,
+    /// Largest penetration of a closed contact / structure size.
+    pub max_penetration_ratio: f64,
+    /// Largest vertex displacement relative to the ground / structure size.
+    pub max_displacement_ratio: f64,
+    /// Energy terms after the step.
+    pub energy: EnergyTerms,
+}
+
+/// Totals over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct RunCounters {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Open-close passes in accepted attempts.
+    pub passes: u64,
+    /// Δt cuts.
+    pub cuts: u64,
+    /// Largest penetration / structure size seen.
+    pub max_penetration_ratio: f64,
+    /// Largest |energy residual| relative to the energy scale seen so far.
+    pub max_energy_residual_rel: f64,
+}
+
+/// Which linear problem an iteration solves.
+#[derive(Debug, Clone, Copy)]
+enum Mode {
+    /// A dynamic step of size dt.
+    Dynamic { dt: f64 },
+    /// Static equilibrium under gravity and loads.
+    Static,
+}
+
+/// Node motion of the current step (for moving joint nodes with their blocks).
+struct StepMotion<'a> {
+    centroids: &'a [Point],
+    increments: &'a [Vec6],
+    exact_rotation: bool,
+}
+
+impl NodeMotion for StepMotion<'_> {
+    fn node_displacement(&self, b: usize, x: Point) -> Point {
+        if self.exact_rotation {
+            point_displacement_exact_rotation(self.centroids[b], x, &self.increments[b])
+        } else {
+            point_displacement(self.centroids[b], x, &self.increments[b])
+        }
+    }
+}
+
+/// The DDA model of a scene, advancing in time.
+#[derive(Debug, Clone)]
+pub struct Dda {
+    blocks: Vec<Block>,
+    ground: usize,
+    ground_kind: GroundKind,
+    dofs: DofMap,
+    pairs: Vec<ContactPair>,
+    contacts: Vec<Contact>,
+    memory: HashMap<ContactKey, ContactMemory>,
+    bolts: Vec<Bolt>,
+    fixed: Vec<FixedPoint>,
+    connections: Vec<Connection>,
+    loads: Vec<PointLoad>,
+    motion: Option<GroundMotion>,
+    gravity: f64,
+    params: SolverParams,
+    coeffs: AlphaCoefficients,
+    time: f64,
+    dt_current: f64,
+    structure_size: f64,
+    search_distance: f64,
+    energy: EnergyTerms,
+    stored_reference: f64,
+    energy_scale: f64,
+    counters: RunCounters,
+    last: StepReport,
+}
+
+impl Dda {
+    /// Builds the model of `scene` driven by `motion` (None: gravity only).
+    ///
+    /// With `params.initial_equilibrium` the model first settles statically under gravity,
+    /// so the dynamic run starts at rest with the penalty springs already carrying the
+    /// weight.
+    pub fn new(scene: &Scene, motion: Option<GroundMotion>, params: SolverParams) -> Result<Self> {
+        scene.validate()?;
+        params.validate()?;
+        let ground = scene.block_index(&scene.ground.block)?;
+        let mut blocks = Vec::with_capacity(scene.blocks.len());
+        for (i, b) in scene.blocks.iter().enumerate() {
+            let role = match (i == ground, scene.ground.kind) {
+                (false, _) => BlockRole::Free,
+                (true, GroundKind::Prescribed) => BlockRole::PrescribedGround,
+                (true, GroundKind::LargeMass) => BlockRole::LargeMassGround,
+            };
+            blocks.push(Block::new(&b.name, b.vertices.clone(), b.material, role)?);
+        }
+        let structure: Vec<Point> = blocks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != ground)
+            .flat_map(|(_, b)| b.vertices.iter().copied())
+            .collect();
+        let structure_size = geometry::bounding_size(&structure);
+        let structure_mass: f64 = blocks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != ground)
+            .map(|(_, b)| b.total_mass())
+            .sum();
+
+        let mut fixed = Vec::new();
+        if scene.ground.kind == GroundKind::LargeMass {
+            // The paper's ground: mass ratio × the structure, on vertical rollers at its two
+            // lowest extreme corners (free to move horizontally, no rotation or bounce).
+            let g = &mut blocks[ground];
+            let target = scene.ground.mass_ratio * structure_mass;
+            g.material.density = target / g.moments.area;
+            g.mass = super::block::mass_matrix(g.material.density, &g.moments);
+            let left = g
+                .vertices
+                .iter()
+                .copied()
+                .fold([f64::INFINITY, 0.0], |m, p| if p[0] < m[0] { p } else { m });
+            let right = g
+                .vertices
+                .iter()
+                .copied()
+                .fold(
+                    [f64::NEG_INFINITY, 0.0],
+                    |m, p| if p[0] > m[0] { p } else { m },
+                );
+            let penalty = 100.0 * g.material.youngs_modulus;
+            for p in [left, right] {
+                fixed.push(FixedPoint {
+                    block: ground,
+                    point: p,
+                    anchor: p,
+                    direction: FixedDirection::Y,
+                    penalty,
+                });
+            }
+        }
+        for f in &scene.fixed_points {
+            let b = scene.block_index(&f.block)?;
+            let penalty = f
+                .penalty
+                .unwrap_or(100.0 * blocks[b].material.youngs_modulus);
+            fixed.push(FixedPoint {
+                block: b,
+                point: f.point,
+                anchor: f.point,
+                direction: f.direction,
+                penalty,
+            });
+        }
+
+        let mut pairs = Vec::new();
+        for c in &scene.contacts {
+            let a = scene.block_index(&c.blocks[0])?;
+            let b = scene.block_index(&c.blocks[1])?;
+            let e = blocks[a]
+                .material
+                .youngs_modulus
+                .max(blocks[b].material.youngs_modulus);
+            let normal = c.normal_penalty.unwrap_or(100.0 * e);
+            let shear = c.shear_penalty.unwrap_or(normal / 2.5);
+            pairs.push(ContactPair {
+                blocks: [a, b],
+                props: JointProps {
+                    friction: c.friction,
+                    normal_penalty: normal,
+                    shear_penalty: shear,
+                    bonded: c.bonded,
+                },
+            });
+        }
+        let mut bolts = Vec::new();
+        for b in &scene.bolts {
+            let i = scene.block_index(&b.blocks[0])?;
+            let j = scene.block_index(&b.blocks[1])?;
+            bolts.push(Bolt {
+                name: b.name.clone(),
+                blocks: [i, j],
+                points: b.points,
+                rest: geometry::sub(b.points[1], b.points[0]),
+                stiffness: b.stiffness,
+                kind: b.kind,
+            });
+        }
+        let mut connections = Vec::new();
+        for c in &scene.connections {
+            let mut owners = [0; 3];
+            for k in 0..3 {
+                owners[k] = scene.block_index(&c.nodes[k].block)?;
+            }
+            connections.push(Connection {
+                blocks: owners,
+                nodes: [c.nodes[0].point, c.nodes[1].point, c.nodes[2].point],
+                elasticity: c.material.elasticity(),
+                strain: [0.0; 3],
+                stress: [0.0; 3],
+            });
+        }
+        let mut loads = Vec::new();
+        for l in &scene.point_loads {
+            loads.push(PointLoad {
+                block: scene.block_index(&l.block)?,
+                point: l.point,
+                force: l.force,
+            });
+        }
+        let is_free: Vec<bool> = blocks
+            .iter()
+            .map(|b| b.role != BlockRole::PrescribedGround)
+            .collect();
+        let dofs = DofMap::new(&is_free);
+        let mut model = Self {
+            blocks,
+            ground,
+            ground_kind: scene.ground.kind,
+            dofs,
+            pairs,
+            contacts: Vec::new(),
+            memory: HashMap::new(),
+            bolts,
+            fixed,
+            connections,
+            loads,
+            motion,
+            gravity: scene.gravity,
+            coeffs: params.integrator.coefficients(),
+            dt_current: params.dt,
+            search_distance: 2.5 * params.max_displacement_ratio * structure_size,
+            params,
+            time: 0.0,
+            structure_size,
+            energy: EnergyTerms::default(),
+            stored_reference: 0.0,
+            energy_scale: 0.0,
+            counters: RunCounters::default(),
+            last: StepReport::default(),
+        };
+        if model.params.initial_equilibrium {
+            model.settle()?;
+        }
+        model.reset_reference();
+        Ok(model)
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The blocks in scene order.
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+
+    /// Index of the ground block.
+    pub fn ground(&self) -> usize {
+        self.ground
+    }
+
+    /// Contacts of the last step (geometry at its start, state at its end).
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    /// Bolts with their current end points.
+    pub fn bolts(&self) -> &[Bolt] {
+        &self.bolts
+    }
+
+    /// Connection elements with their current nodes.
+    pub fn connections(&self) -> &[Connection] {
+        &self.connections
+    }
+
+    /// Energy terms now.
+    pub fn energy(&self) -> EnergyTerms {
+        self.energy
+    }
+
+    /// Run totals.
+    pub fn counters(&self) -> RunCounters {
+        self.counters
+    }
+
+    /// The last step's report.
+    pub fn last_report(&self) -> StepReport {
+        self.last
+    }
+
+    /// Solver parameters.
+    pub fn params(&self) -> &SolverParams {
+        &self.params
+    }
+
+    /// Size of the structure (bounding diagonal of all blocks but the ground), m.
+    pub fn structure_size(&self) -> f64 {
+        self.structure_size
+    }
+
+    /// Index of a block by name.
+    pub fn block_index(&self, name: &str) -> Result<usize> {
+        self.blocks
+            .iter()
+            .position(|b| b.name == name)
+            .ok_or_else(|| Error::Scene(format!("unknown block '{name}'")))
+    }
+
+    /// Ground acceleration at time t (the input, not the large-mass ground's response).
+    pub fn ground_accel(&self, t: f64) -> f64 {
+        self.motion.as_ref().map_or(0.0, |m| m.accel(t))
+    }
+
+    /// Makes the current state the reference: displacements and energies count from here.
+    fn reset_reference(&mut self) {
+        for b in &mut self.blocks {
+            b.reference_centroid = b.moments.centroid;
+            b.rotation = 0.0;
+            b.velocity = [0.0; 6];
+            b.accel = [0.0; 6];
+        }
+        self.energy = EnergyTerms::default();
+        self.stored_reference = self.stored_energy();
+        self.energy_scale = 0.0;
+    }
+
+    fn is_structure(&self, b: usize) -> bool {
+        b != self.ground
+    }
+
+    /// Known increments of prescribed blocks for a step from t to t + dt.
+    fn known_increments(&self, mode: Mode) -> Vec<Vec6> {
+        let mut known = vec![[0.0; 6]; self.blocks.len()];
+        if let (Mode::Dynamic { dt }, GroundKind::Prescribed, Some(m)) =
+            (mode, self.ground_kind, &self.motion)
+        {
+            known[self.ground][0] = m.displacement(self.time + dt) - m.displacement(self.time);
+        }
+        known
+    }
+
+    fn element_terms(&self) -> Vec<ElementTerms> {
+        let mut out =
+            Vec::with_capacity(self.bolts.len() + self.fixed.len() + self.connections.len());
+        out.extend(self.bolts.iter().map(Bolt::terms));
+        out.extend(self.fixed.iter().map(FixedPoint::terms));
+        out.extend(self.connections.iter().map(Connection::terms));
+        out
+    }
+
+    /// Assembles everything that does not depend on contact states.
+    fn assemble_base(&self, mode: Mode, known: &[Vec6], elements: &[ElementTerms]) -> System {
+        let c = &self.coeffs;
+        let (mass_factor, stiffness_factor) = match mode {
+            Mode::Dynamic { dt } => ((1.0 - c.alpha_m) / (c.beta * dt * dt), 1.0 - c.alpha_f),
+            // A vanishing "mass spring" (1 mHz) only so that unloaded rigid-body modes (a
+            // roof hung on one bolt can still turn) do not make the static matrix singular.
+            Mode::Static => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
+        };
+        let mut sys = System::zeros(self.dofs.n, stiffness_factor);
+        for (bi, b) in self.blocks.iter().enumerate() {
+            let Some(s) = self.dofs.slot[bi] else {
+                continue;
+            };
+            sys.add_diag_block(s, &b.mass, mass_factor);
+            // Elastic stiffness on the strain unknowns and the initial-stress force.
+            for i in 0..3 {
+                for j in 0..3 {
+                    sys.k[(s + 3 + i, s + 3 + j)] +=
+                        stiffness_factor * b.moments.area * b.elasticity[i][j];
+                }
+                sys.r[s + 3 + i] -= b.moments.area * b.stress[i];
+            }
+            // Gravity.
+            sys.r[s + 1] -= b.total_mass() * self.gravity;
+            if let Mode::Dynamic { dt } = mode {
+                // Inertia from the previous step: −M[(1 − αm) ã + αm a], with
+                // ã = −v/(βΔt) − (1/(2β) − 1) a.
+                let mut w = [0.0; 6];
+                for k in 0..6 {
+                    let a_tilde =
+                        -b.velocity[k] / (c.beta * dt) - (0.5 / c.beta - 1.0) * b.accel[k];
+                    w[k] = (1.0 - c.alpha_m) * a_tilde + c.alpha_m * b.accel[k];
+                }
+                for i in 0..6 {
+                    let mw: f64 = (0..6).map(|j| b.mass[i][j] * w[j]).sum();
+                    sys.r[s + i] -= mw;
+                }
+                if b.role == BlockRole::LargeMassGround {
+                    // Paper eq. (4): f = m_g ü0, at the generalised-α time point.
+                    let t_alpha = self.time + (1.0 - c.alpha_f) * dt;
+                    sys.r[s] += b.total_mass() * self.ground_accel(t_alpha);
+                }
+            }
+        }
+        let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        for e in elements {
+            sys.add_nodal_element(&self.dofs, known, &centroids, &e.nodes, &e.ke, &e.fe);
+        }
+        for l in &self.loads {
+            if let Some(s) = self.dofs.slot[l.block] {
+                let f = t_transpose_times(centroids[l.block], l.point, l.force);
+                sys.add_rhs(s, &f, 1.0);
+            }
+        }
+        sys
+    }
+
+    /// Adds the contact terms of the current trial states.
+    fn add_contacts(&self, sys: &mut System, known: &[Vec6]) {
+        for c in &self.contacts {
+            let (i, j) = (c.key.vertex_block, c.key.edge_block);
+            match c.state {
+                ContactState::Open => {}
+                ContactState::Locked => {
+                    let p = c.props.normal_penalty;
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        known,
+                        p,
+                        p * c.gap0,
+                        (i, &c.gap_i),
+                        Some((j, &c.gap_j)),
+                    );
+                    let ps = c.props.shear_penalty;
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        known,
+                        ps,
+                        ps * c.shear0,
+                        (i, &c.slip_i),
+                        Some((j, &c.slip_j)),
+                    );
+                }
+                ContactState::Sliding { direction } => {
+                    let p = c.props.normal_penalty;
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        known,
+                        p,
+                        p * c.gap0,
+                        (i, &c.gap_i),
+                        Some((j, &c.gap_j)),
+                    );
+                    // Friction: −δρN along the slip direction on the vertex, +δρN on the edge;
+                    // as generalised forces that is −δρN·(slip_i, slip_j).
+                    let f = -direction * c.props.friction * c.friction_normal;
+                    if let Some(s) = self.dofs.slot[i] {
+                        sys.add_rhs(s, &c.slip_i, f);
+                    }
+                    if let Some(s) = self.dofs.slot[j] {
+                        sys.add_rhs(s, &c.slip_j, f);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Runs the open-close iteration. Returns the increments of all blocks and the number
+    /// of passes, or `None` if the states did not settle within the allowed passes.
+    fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Option<(Vec<Vec6>, usize)>> {
+        let elements = self.element_terms();
+        let base = self.assemble_base(mode, known, &elements);
+        let alpha_f = match mode {
+            Mode::Dynamic { .. } => self.coeffs.alpha_f,
+            Mode::Static => 0.0,
+        };
+        let open_tolerance = 1e-9 * self.structure_size;
+        let slip_tolerance = 1e-12 * self.structure_size;
+        let max_passes = self.params.max_open_close_passes;
+        for pass in 1..=max_passes {
+            let mut sys = base.clone();
+            self.add_contacts(&mut sys, known);
+            let solution = sys.solve(self.time)?;
+            let increments = self.increments(&solution, known);
+            let mut changed = false;
+            let mut max_normal = 0.0_f64;
+            for c in &self.contacts {
+                max_normal = max_normal.max(c.friction_normal);
+            }
+            for c in &mut self.contacts {
+                let di = &increments[c.key.vertex_block];
+                let dj = &increments[c.key.edge_block];
+                let gap = c.gap_end(di, dj);
+                let slip = c.slip_increment(di, dj);
+                let normal_force = c.props.normal_penalty * (-gap).max(0.0);
+                let new_state = judge(&JudgeInput {
+                    state: c.state,
+                    gap,
+                    shear_force: c.props.shear_penalty * (c.shear0 + slip),
+                    normal_force,
+                    friction: c.props.friction,
+                    slip_increment: slip,
+                    bonded: c.props.bonded,
+                    open_tolerance,
+                    slip_tolerance,
+                });
+                // Friction acts with the normal force at the generalised-α time point.
+                let gap_alpha = alpha_f * c.gap0 + (1.0 - alpha_f) * gap;
+                let n_alpha = c.props.normal_penalty * (-gap_alpha).max(0.0);
+                if let ContactState::Sliding { .. } = new_state {
+                    if (n_alpha - c.friction_normal).abs() > 1e-6 * max_normal.max(n_alpha) {
+                        changed = true;
+                    }
+                }
+                c.friction_normal = n_alpha;
+                if new_state != c.state {
+                    // A contact that changes state within the step restarts its shear
+                    // spring from the step start only if it was locked then.
+                    changed = true;
+                    c.state = new_state;
+                }
+            }
+            if !changed {
+                return Ok(Some((increments, pass)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Increments of all blocks from the solution vector and the known ones.
+    fn increments(&self, solution: &DVector<f64>, known: &[Vec6]) -> Vec<Vec6> {
+        (0..self.blocks.len())
+            .map(|b| match self.dofs.slot[b] {
+                Some(s) => {
+                    let mut d = [0.0; 6];
+                    for k in 0..6 {
+                        d[k] = solution[s + k];
+                    }
+                    d
+                }
+                None => known[b],
+            })
+            .collect()
+    }
+
+    /// Static equilibrium under gravity and loads (the ground does not move).
+    fn settle(&mut self) -> Result<()> {
+        let known = vec![[0.0; 6]; self.blocks.len()];
+        contact::detect(
+            &self.blocks,
+            &self.pairs,
+            &self.memory,
+            self.search_distance,
+            &mut self.contacts,
+        );
+        let Some((increments, _)) = self.iterate(Mode::Static, &known)? else {
+            return Err(Error::Solver {
+                time: 0.0,
+                reason:
+                    "the initial equilibrium under gravity did not settle (contact states keep \
+                         changing); check that blocks rest on each other, or set \
+                         solver.initial_equilibrium = false"
+                        .into(),
+            });
+        };
+        let ratio = self.max_relative_displacement(&increments, &known);
+        // Supported blocks settle by millimetres (a roof hung on a 1 Hz spring by 25 cm);
+        // an unsupported one falls by g/(2π·1 mHz)² ≈ 250 km on the regularising spring.
+        if ratio > 1.0 {
+            return Err(Error::Solver {
+                time: 0.0,
+                reason: format!(
+                    "a block moves {:.3} structure sizes to reach equilibrium under gravity: it is \
+                     not supported (no contact, bolt or fixed point holds it)",
+                    ratio
+                ),
+            });
+        }
+        self.commit_geometry(&increments)?;
+        Ok(())
+    }
+
+    /// Largest vertex displacement of the structure relative to the ground translation,
+    /// as a fraction of the structure size.
+    fn max_relative_displacement(&self, increments: &[Vec6], _known: &[Vec6]) -> f64 {
+        let g = increments[self.ground];
+        let mut max = 0.0_f64;
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if bi == self.ground {
+                continue;
+            }
+            for &p in &b.vertices {
+                let u = point_displacement(b.moments.centroid, p, &increments[bi]);
+                max = max.max((u[0] - g[0]).hypot(u[1] - g[1]));
+            }
+        }
+        max / self.structure_size
+    }
+
+    /// Moves blocks and joints by the increments and updates the contact memory.
+    fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
+        let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let motion = StepMotion {
+            centroids: &centroids,
+            increments,
+            exact_rotation: self.params.exact_rotation,
+        };
+        for b in &mut self.bolts {
+            b.commit(&motion);
+        }
+        for f in &mut self.fixed {
+            f.commit(&motion);
+        }
+        for c in &mut self.connections {
+            c.commit(&motion);
+        }
+        for l in &mut self.loads {
+            let u = motion.node_displacement(l.block, l.point);
+            l.point[0] += u[0];
+            l.point[1] += u[1];
+        }
+        for (b, d) in self.blocks.iter_mut().zip(increments) {
+            b.apply_increment(d, self.params.exact_rotation)?;
+        }
+        self.memory.clear();
+        for c in &self.contacts {
+            let di = &increments[c.key.vertex_block];
+            let dj = &increments[c.key.edge_block];
+            let gap = c.gap_end(di, dj);
+            let shear = match c.state {
+                ContactState::Locked => c.shear0 + c.slip_increment(di, dj),
+                _ => 0.0,
+            };
+            self.memory.insert(
+                c.key,
+                ContactMemory {
+                    state: c.state,
+                    shear,
+                    normal_force: c.props.normal_penalty * (-gap).max(0.0),
+                },
+            );
+        }
+        Ok(())
+    }
+
+    /// Elastic energy stored in blocks, joints and contact springs of the structure.
+    fn stored_energy(&self) -> f64 {
+        let mut e = 0.0;
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if self.is_structure(bi) {
+                e += b.strain_energy();
+            }
+        }
+        for b in &self.bolts {
+            if b.blocks.iter().any(|&k| self.is_structure(k)) {
+                e += b.energy();
+            }
+        }
+        for f in &self.fixed {
+            if self.is_structure(f.block) {
+                e += f.energy();
+            }
+        }
+        for c in &self.connections {
+            if c.blocks.iter().any(|&k| self.is_structure(k)) {
+                e += c.energy();
+            }
+        }
+        for (key, m) in &self.memory {
+            if !m.state.is_closed() {
+                continue;
+            }
+            let Some(pair) = self.contacts.iter().find(|c| c.key == *key) else {
+                continue;
+            };
+            let p = pair.props;
+            e += 0.5 * m.normal_force * m.normal_force / p.normal_penalty;
+            if m.state == ContactState::Locked {
+                e += 0.5 * p.shear_penalty * m.shear * m.shear;
+            }
+        }
+        e
+    }
+
+    /// Advances one step (of at most `max_dt`), cutting Δt as needed.
+    pub fn step(&mut self, max_dt: f64) -> Result<StepReport> {
+        let mut cuts = 0;
+        let dt_min = self.params.dt * self.params.min_dt_fraction;
+        loop {
+            let dt = self.dt_current.min(max_dt);
+            let mode = Mode::Dynamic { dt };
+            let known = self.known_increments(mode);
+            contact::detect(
+                &self.blocks,
+                &self.pairs,
+                &self.memory,
+                self.search_distance,
+                &mut self.contacts,
+            );
+            let outcome = self.iterate(mode, &known)?;
+            let reason = match outcome {
+                None => format!(
+                    "the open-close iteration did not settle in {} passes",
+                    self.params.max_open_close_passes
+                ),
+                Some((increments, passes)) => {
+                    let ratio = self.max_relative_displacement(&increments, &known);
+                    if ratio <= self.params.max_displacement_ratio {
+                        let report = self.commit_step(dt, &increments, passes, cuts, ratio)?;
+                        // Grow back towards the nominal step after a cut.
+                        self.dt_current = (self.dt_current * 1.5).min(self.params.dt);
+                        return Ok(report);
+                    }
+                    format!(
+                        "a vertex moved {ratio:.2e} structure sizes in one step (limit {:.2e})",
+                        self.params.max_displacement_ratio
+                    )
+                }
+            };
+            cuts += 1;
+            self.counters.cuts += 1;
+            self.dt_current *= self.params.cut_factor;
+            if self.dt_current < dt_min {
+                return Err(Error::Solver {
+                    time: self.time,
+                    reason: format!(
+                        "{reason}, even with Δt cut to {:.3e} s; the contact springs may be far too \
+                         stiff or soft for this Δt, or blocks interpenetrate",
+                        dt
+                    ),
+                });
+            }
+        }
+    }
+
+    /// Accepts a converged step: integrator update, energy bookkeeping, geometry.
+    fn commit_step(
+        &mut self,
+        dt: f64,
+        increments: &[Vec6],
+        passes: usize,
+        cuts: usize,
+        ratio: f64,
+    ) -> Result<StepReport> {
+        let c = self.coeffs;
+        let t_new = self.time + dt;
+        // Newmark update of velocities and accelerations.
+        for (bi, b) in self.blocks.iter_mut().enumerate() {
+            match b.role {
+                BlockRole::PrescribedGround => {
+                    let (v, a) = match &self.motion {
+                        Some(m) => (m.velocity(t_new), m.accel(t_new)),
+                        None => (0.0, 0.0),
+                    };
+                    b.velocity = [v, 0.0, 0.0, 0.0, 0.0, 0.0];
+                    b.accel = [a, 0.0, 0.0, 0.0, 0.0, 0.0];
+                }
+                _ => {
+                    let d = &increments[bi];
+                    for k in 0..6 {
+                        let a_new = d[k] / (c.beta * dt * dt)
+                            - b.velocity[k] / (c.beta * dt)
+                            - (0.5 / c.beta - 1.0) * b.accel[k];
+                        b.velocity[k] += dt * ((1.0 - c.gamma) * b.accel[k] + c.gamma * a_new);
+                        b.accel[k] = a_new;
+                    }
+                }
+            }
+        }
+        // Work and dissipation over the step.
+        let g = self.ground;
+        let dg = increments[g];
+        let mut input = 0.0;
+        let mut dissipated = 0.0;
+        let mut max_pen = 0.0_f64;
+        let (mut closed, mut sliding) = (0, 0);
+        for ct in &self.contacts {
+            let (i, j) = (ct.key.vertex_block, ct.key.edge_block);
+            let (di, dj) = (&increments[i], &increments[j]);
+            let gap = ct.gap_end(di, dj);
+            let slip = ct.slip_increment(di, dj);
+            if ct.state.is_closed() {
+                closed += 1;
+                max_pen = max_pen.max(-gap);
+            }
+            // Which side (if any) is the ground, and the ground part of each gradient.
+            let ground_side = if j == g {
+                Some(false)
+            } else if i == g {
+                Some(true)
+            } else {
+                None
+            };
+            let pick = |vi: &Vec6, vj: &Vec6| match ground_side {
+                Some(true) => dot6(vi, &dg),
+                Some(false) => dot6(vj, &dg),
+                None => 0.0,
+            };
+            match ct.state {
+                ContactState::Open => {}
+                ContactState::Locked => {
+                    let p = ct.props.normal_penalty;
+                    input += 0.5 * p * (ct.gap0 + gap) * pick(&ct.gap_i, &ct.gap_j);
+                    let ps = ct.props.shear_penalty;
+                    input += 0.5 * ps * (2.0 * ct.shear0 + slip) * pick(&ct.slip_i, &ct.slip_j);
+                }
+                ContactState::Sliding { direction } => {
+                    sliding += 1;
+                    let p = ct.props.normal_penalty;
+                    input += 0.5 * p * (ct.gap0 + gap) * pick(&ct.gap_i, &ct.gap_j);
+                    let f = ct.props.friction * ct.friction_normal;
+                    input += direction * f * pick(&ct.slip_i, &ct.slip_j);
+                    dissipated += f * slip.abs();
+                    // The stuck shear spring's energy is released when sliding starts.
+                    if ct.start_state == ContactState::Locked {
+                        dissipated += 0.5 * ct.props.shear_penalty * ct.shear0 * ct.shear0;
+                    }
+                }
+            }
+        }
+        // Joints that tie the structure to the ground.
+        let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let ground_elements: Vec<ElementTerms> = self
+            .bolts
+            .iter()
+            .filter(|b| b.blocks.contains(&g) && b.blocks.iter().any(|&k| k != g))
+            .map(Bolt::terms)
+            .chain(
+                self.connections
+                    .iter()
+                    .filter(|c| c.blocks.contains(&g) && c.blocks.iter().any(|&k| k != g))
+                    .map(Connection::terms),
+            )
+            .collect();
+        for e in &ground_elements {
+            let u: Vec<Point> = e
+                .nodes
+                .iter()
+                .map(|&(b, x)| point_displacement(centroids[b], x, &increments[b]))
+                .collect();
+            let end = e.end_forces(&u);
+            for (k, &(b, _)) in e.nodes.iter().enumerate() {
+                if b == g {
+                    input += 0.5
+                        * ((e.fe[2 * k] + end[2 * k]) * u[k][0]
+                            + (e.fe[2 * k + 1] + end[2 * k + 1]) * u[k][1]);
+                }
+            }
+        }
+        // Gravity and point loads on the structure.
+        let mut external = 0.0;
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if self.is_structure(bi) {
+                external -= b.total_mass() * self.gravity * increments[bi][1];
+            }
+        }
+        for l in &self.loads {
+            if self.is_structure(l.block) {
+                let u = point_displacement(centroids[l.block], l.point, &increments[l.block]);
+                external += l.force[0] * u[0] + l.force[1] * u[1];
+            }
+        }
+        self.commit_geometry(increments)?;
+        self.time = t_new;
+
+        self.energy.input_work += input;
+        self.energy.external_work += external;
+        self.energy.friction_dissipated += dissipated;
+        self.energy.kinetic = self
+            .blocks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != g)
+            .map(|(_, b)| b.kinetic_energy())
+            .sum();
+        self.energy.strain = self.stored_energy() - self.stored_reference;
+        self.energy_scale = self
+            .energy_scale
+            .max(self.energy.input_work.abs())
+            .max(self.energy.kinetic + self.energy.strain.abs() + self.energy.friction_dissipated);
+        let residual_rel = if self.energy_scale > 0.0 {
+            self.energy.residual().abs() / self.energy_scale
+        } else {
+            0.0
+        };
+
+        if self.blocks.iter().any(|b| {
+            b.velocity
+                .iter()
+                .chain(b.accel.iter())
+                .any(|v| !v.is_finite())
+        }) {
+            return Err(Error::Solver {
+                time: self.time,
+                reason: "a velocity or acceleration became non-finite".into(),
+            });
+        }
+        let report = StepReport {
+            time: self.time,
+            dt,
+            passes,
+            cuts,
+            contacts: self.contacts.len(),
+            closed,
+            sliding,
+            max_penetration_ratio: max_pen / self.structure_size,
+            max_displacement_ratio: ratio,
+            energy: self.energy,
+        };
+        self.counters.steps += 1;
+        self.counters.passes += passes as u64;
+        self.counters.max_penetration_ratio = self
+            .counters
+            .max_penetration_ratio
+            .max(report.max_penetration_ratio);
+        self.counters.max_energy_residual_rel =
+            self.counters.max_energy_residual_rel.max(residual_rel);
+        self.last = report;
+        Ok(report)
+    }
+
+    /// Relative energy residual now: |residual| / the largest energy that has passed through.
+    pub fn energy_residual_relative(&self) -> f64 {
+        if self.energy_scale > 0.0 {
+            self.energy.residual() / self.energy_scale
+        } else {
+            0.0
+        }
+    }
+
+    /// Advances until `t_end`, calling `observe` after every step.
+    pub fn run_until(
+        &mut self,
+        t_end: f64,
+        mut observe: impl FnMut(&Dda, &StepReport),
+    ) -> Result<()> {
+        while self.time < t_end - 1e-9 * self.params.dt {
+            let report = self.step(t_end - self.time)?;
+            observe(self, &report);
+        }
+        Ok(())
+    }
+}

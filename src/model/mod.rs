@@ -1,0 +1,8 @@
+//! Scenes as data: geometry, materials, the scene description and the built-in presets.
+
+pub mod geometry;
+pub mod material;
+pub mod presets;
+pub mod scene;
+
+pub use scene::Scene;
