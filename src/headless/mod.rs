@@ -1,0 +1,8 @@
+//! Everything the program does without a window: single runs, sweeps, reports.
+//!
+//! These functions are what the command line calls; they return plain data and write files,
+//! and never print (printing is the binary's job), so tests and other front ends can use them.
+
+pub mod run;
+pub mod sweep;
+pub mod two_block;

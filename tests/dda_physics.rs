@@ -1,0 +1,190 @@
+//! Physical facts the DDA solver must reproduce on small scenes with known answers.
+
+use slidebase::dda::{Dda, Integrator, SolverParams};
+use slidebase::model::Scene;
+
+const G: f64 = 9.80665;
+
+fn incline_scene(theta_deg: f64, friction: f64) -> (Scene, f64) {
+    let (s, c) = theta_deg.to_radians().sin_cos();
+    let l = 20.0;
+    let a = 1.0;
+    let x0 = 10.0;
+    let p0 = [x0 * c, x0 * s];
+    let v = [
+        p0,
+        [p0[0] + a * c, p0[1] + a * s],
+        [p0[0] + a * c - a * s, p0[1] + a * s + a * c],
+        [p0[0] - a * s, p0[1] + a * c],
+    ];
+    let fmt = |p: [f64; 2]| format!("[{:.15}, {:.15}]", p[0], p[1]);
+    let text = format!(
+        r#"
+name = "incline"
+[[block]]
+name = "ground"
+vertices = [[0.0, -1.0], [{lc}, -1.0], [{lc}, {ls}], [0.0, 0.0]]
+material = {{ density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }}
+[[block]]
+name = "box"
+vertices = [{v0}, {v1}, {v2}, {v3}]
+material = {{ density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }}
+[ground]
+block = "ground"
+[[contact]]
+blocks = ["box", "ground"]
+friction = {friction}
+"#,
+        lc = l * c,
+        ls = l * s,
+        v0 = fmt(v[0]),
+        v1 = fmt(v[1]),
+        v2 = fmt(v[2]),
+        v3 = fmt(v[3]),
+    );
+    (Scene::from_toml(&text, "incline").unwrap(), c)
+}
+
+/// Along-slope (down-slope positive) displacement of the box after `t_end` seconds.
+fn slide_down(theta_deg: f64, friction: f64, t_end: f64) -> (f64, Dda) {
+    let (scene, _) = incline_scene(theta_deg, friction);
+    let params = SolverParams {
+        dt: 1e-3,
+        duration: t_end,
+        ..SolverParams::default()
+    };
+    let mut dda = Dda::new(&scene, None, params).unwrap();
+    let b = dda.block_index("box").unwrap();
+    dda.run_until(t_end, |_, _| {}).unwrap();
+    let (s, c) = theta_deg.to_radians().sin_cos();
+    let u = dda.blocks()[b].centroid_displacement();
+    (-(u[0] * c + u[1] * s), dda)
+}
+
+/// A block on a 30° incline with μ = 0.3 slides with a = g(sin θ − μ cos θ): after 1 s it
+/// has travelled ½at² (closed form) to within 1 %.
+#[test]
+fn block_slides_down_an_incline_with_coulomb_acceleration() {
+    let theta: f64 = 30.0;
+    let mu = 0.3;
+    let (s, c) = theta.to_radians().sin_cos();
+    let expected = 0.5 * G * (s - mu * c) * 1.0;
+    let (travel, dda) = slide_down(theta, mu, 1.0);
+    assert!(
+        (travel - expected).abs() < 0.01 * expected,
+        "travel {travel:.5} m, expected {expected:.5} m"
+    );
+    // Energy: gravity's work = kinetic + friction + elastic, up to numerical dissipation.
+    let e = dda.energy();
+    assert!(e.friction_dissipated > 0.0);
+    assert!(
+        dda.energy_residual_relative().abs() < 1e-3,
+        "energy residual {}",
+        dda.energy_residual_relative()
+    );
+}
+
+/// With tan θ < μ the block stays where it is (friction holds it).
+#[test]
+fn block_stays_on_an_incline_when_friction_holds() {
+    let (travel, dda) = slide_down(20.0, 0.5, 1.0);
+    assert!(travel.abs() < 1e-6, "the block crept {travel:.3e} m");
+    assert!(dda.counters().max_penetration_ratio < 1e-5);
+}
+
+/// A block resting on the ground stays at rest: after initial equilibrium nothing moves
+/// and the contact penetration is far below the block size.
+#[test]
+fn block_at_rest_on_the_ground_stays_at_rest() {
+    let text = r#"
+name = "rest"
+[[block]]
+name = "ground"
+vertices = [[-10.0, -1.0], [10.0, -1.0], [10.0, 0.0], [-10.0, 0.0]]
+material = { density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }
+[[block]]
+name = "box"
+vertices = [[-1.0, 0.0], [1.0, 0.0], [1.0, 1.0], [-1.0, 1.0]]
+material = { density = 2500.0, youngs_modulus = 3.0e10, poisson_ratio = 0.2 }
+[ground]
+block = "ground"
+[[contact]]
+blocks = ["box", "ground"]
+friction = 0.6
+"#;
+    let scene = Scene::from_toml(text, "rest").unwrap();
+    for integrator in [
+        Integrator::Classic,
+        Integrator::Trapezoidal,
+        Integrator::default(),
+    ] {
+        let params = SolverParams {
+            dt: 1e-3,
+            duration: 2.0,
+            integrator,
+            ..SolverParams::default()
+        };
+        let mut dda = Dda::new(&scene, None, params).unwrap();
+        let b = dda.block_index("box").unwrap();
+        dda.run_until(2.0, |_, _| {}).unwrap();
+        let u = dda.blocks()[b].centroid_displacement();
+        assert!(u[0].hypot(u[1]) < 1e-9, "{integrator:?}: box moved {u:?}");
+        assert!(
+            dda.counters().max_penetration_ratio < 1e-5,
+            "penetration {}",
+            dda.counters().max_penetration_ratio
+        );
+        assert!(dda.counters().cuts == 0);
+    }
+}
+
+/// A free block thrown in space (no gravity, no contacts) moves as a rigid body: its
+/// strains stay zero, its area is preserved and the trapezoidal rule keeps its kinetic
+/// energy. Rigid-body motion produces no elastic force.
+#[test]
+fn rigid_body_motion_produces_no_strain() {
+    let text = r#"
+name = "free"
+gravity = 0.0
+[[block]]
+name = "ground"
+vertices = [[-10.0, -11.0], [10.0, -11.0], [10.0, -10.0], [-10.0, -10.0]]
+material = { density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }
+[[block]]
+name = "box"
+vertices = [[0.0, 0.0], [2.0, 0.3], [1.5, 1.2], [-0.2, 0.9]]
+material = { density = 2500.0, youngs_modulus = 3.0e10, poisson_ratio = 0.2 }
+[ground]
+block = "ground"
+[[point_load]]
+block = "box"
+point = [0.8, 0.6]
+force = [0.0, 0.0]
+"#;
+    let scene = Scene::from_toml(text, "free").unwrap();
+    let params = SolverParams {
+        dt: 1e-3,
+        duration: 1.0,
+        integrator: Integrator::Trapezoidal,
+        initial_equilibrium: false,
+        ..SolverParams::default()
+    };
+    let mut dda = Dda::new(&scene, None, params).unwrap();
+    let b = dda.block_index("box").unwrap();
+    let area0 = dda.blocks()[b].moments.area;
+    dda.set_velocity(b, [0.3, -0.2, 0.5, 0.0, 0.0, 0.0])
+        .unwrap();
+    let ke0 = dda.blocks()[b].kinetic_energy();
+    dda.run_until(1.0, |_, _| {}).unwrap();
+    let blk = &dda.blocks()[b];
+    for e in blk.strain {
+        assert!(e.abs() < 1e-12, "strain {e}");
+    }
+    assert!((blk.moments.area - area0).abs() < 1e-10 * area0);
+    assert!((blk.kinetic_energy() - ke0).abs() < 1e-9 * ke0);
+    assert!(
+        (blk.rotation - 0.5).abs() < 1e-9,
+        "rotation {}",
+        blk.rotation
+    );
+}
