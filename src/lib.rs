@@ -15,6 +15,7 @@
 //!
 //! The engine never depends on rendering; the visualizer lives behind the `gui` feature.
 
+pub mod analytic;
 pub mod dda;
 pub mod error;
 pub mod ground_motion;

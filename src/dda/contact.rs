@@ -56,7 +56,8 @@ pub struct ContactPair {
 pub struct ContactMemory {
     /// State at the end of the last accepted step.
     pub state: ContactState,
-    /// Shear spring stretch at the end of the last step (0 unless locked), m.
+    /// Shear spring stretch at the end of the last step, m: free while locked, the yield
+    /// stretch ±ρN/p_s while sliding, 0 when open.
     pub shear: f64,
     /// Normal force at the end of the last step, N.
     pub normal_force: f64,
@@ -83,12 +84,24 @@ pub struct Contact {
     pub slip_j: Vec6,
     /// State at the step start.
     pub start_state: ContactState,
-    /// Shear stretch at the step start (only kept if the contact was locked), m.
+    /// Shear spring stretch at the step start, m.
     pub shear0: f64,
     /// Trial state for the current open-close pass.
     pub state: ContactState,
+    /// Mass a dashpot on this contact acts against (half the lighter free block: two
+    /// contacts usually share a face), kg.
+    pub damping_mass: f64,
+    /// State changes in the current step's open-close iteration.
+    pub flips: u32,
     /// Normal force used for friction in the current pass, N.
     pub friction_normal: f64,
+    /// Tangential slip velocity (vertex relative to edge) at the step start, m/s.
+    pub start_slip_velocity: f64,
+    /// Tangential slip velocity at the end of the last trial solution, m/s.
+    pub end_slip_velocity: f64,
+    /// Where in the step (fraction 0..1) the state first changed from the start state in
+    /// the open-close iteration; 1 when it did not. Used to land steps on stick-slip events.
+    pub event_fraction: f64,
     /// Contact point (P1) and edge tangent at the step start, for drawing and reports.
     pub point: Point,
     /// Edge unit tangent t̂.
@@ -99,6 +112,25 @@ impl Contact {
     /// Gap at the end of the step for unknowns `di`, `dj`.
     pub fn gap_end(&self, di: &Vec6, dj: &Vec6) -> f64 {
         self.gap0 + dot6(&self.gap_i, di) + dot6(&self.gap_j, dj)
+    }
+
+    /// Where in the step (0..1) this contact had an event: the first change of state in
+    /// the open-close iteration, or, for a contact that kept sliding, the zero of its slip
+    /// velocity (linear over the step) when the velocity reversed but the increment not yet.
+    pub fn event_fraction_in_step(&self) -> f64 {
+        if self.state != self.start_state {
+            return self.event_fraction;
+        }
+        if let ContactState::Sliding { direction } = self.state {
+            let (v0, v1) = (
+                self.start_slip_velocity * direction,
+                self.end_slip_velocity * direction,
+            );
+            if v0 > 0.0 && v1 < 0.0 {
+                return v0 / (v0 - v1);
+            }
+        }
+        1.0
     }
 
     /// Tangential slip increment for unknowns `di`, `dj`.
@@ -311,15 +343,10 @@ fn linearise(
     let tq = t_transpose_times(cj, q, t);
     let slip_j = tq.map(|v| -v);
     let (start_state, shear0, normal) = match mem {
-        Some(m) => (
-            m.state,
-            if m.state == ContactState::Locked {
-                m.shear
-            } else {
-                0.0
-            },
-            m.normal_force,
-        ),
+        // The shear spring is elastic-perfectly-plastic: while sliding it stays stretched
+        // at its yield value (force ρN), so a contact that stops picks up the friction
+        // force continuously instead of dropping it to zero and ringing.
+        Some(m) => (m.state, m.shear, m.normal_force),
         // Touching or overlapping when first seen: closed and stuck (blocks placed on each
         // other start in contact); otherwise open.
         None if gap0 <= 0.0 => (ContactState::Locked, 0.0, props.normal_penalty * (-gap0)),
@@ -330,6 +357,7 @@ fn linearise(
     } else {
         start_state
     };
+    let start_slip_velocity = dot6(&slip_i, &vblock.velocity) + dot6(&slip_j, &eblock.velocity);
     Contact {
         key,
         pair,
@@ -343,6 +371,19 @@ fn linearise(
         shear0,
         state: start_state,
         friction_normal: normal,
+        damping_mass: {
+            use super::block::BlockRole::Free;
+            let (mi, mj) = (vblock.total_mass(), eblock.total_mass());
+            0.5 * match (vblock.role == Free, eblock.role == Free) {
+                (true, false) => mi,
+                (false, true) => mj,
+                _ => mi.min(mj),
+            }
+        },
+        flips: 0,
+        start_slip_velocity,
+        end_slip_velocity: start_slip_velocity,
+        event_fraction: 1.0,
         point: p1,
         tangent: t,
     }

@@ -19,22 +19,26 @@ pub struct EnergyTerms {
     /// Energy dissipated by Coulomb friction (including the shear-spring energy released
     /// when a stuck contact starts to slide).
     pub friction_dissipated: f64,
+    /// Energy dissipated by the contact dashpots (relative motion across closed joints).
+    pub contact_damping: f64,
 }
 
 impl EnergyTerms {
     /// Numerical dissipation: what the integrator lost (positive) or created (negative).
     /// Zero to round-off for the trapezoidal rule on a linear problem.
     pub fn residual(&self) -> f64 {
-        self.input_work + self.external_work - self.kinetic - self.strain - self.friction_dissipated
+        self.input_work + self.external_work
+            - self.kinetic
+            - self.strain
+            - self.friction_dissipated
+            - self.contact_damping
     }
 
     /// Residual relative to the energy that passed through the system.
     pub fn residual_relative(&self) -> f64 {
-        let scale = self
-            .input_work
-            .abs()
-            .max(self.external_work.abs())
-            .max(self.kinetic + self.strain.abs() + self.friction_dissipated);
+        let scale = self.input_work.abs().max(self.external_work.abs()).max(
+            self.kinetic + self.strain.abs() + self.friction_dissipated + self.contact_damping,
+        );
         if scale > 0.0 {
             self.residual() / scale
         } else {

@@ -48,6 +48,8 @@ pub struct JudgeInput {
     pub friction: f64,
     /// Tangential slip of the vertex relative to the edge in this step, m.
     pub slip_increment: f64,
+    /// Tangential slip velocity at the end of the step, m/s.
+    pub slip_velocity: f64,
     /// A bonded joint never opens or slides.
     pub bonded: bool,
     /// A closed contact opens only when the gap exceeds this (small, > 0) value: a little
@@ -63,8 +65,8 @@ pub struct JudgeInput {
 /// - Closed → Open when the gap opens beyond the tolerance (no tension in contacts).
 /// - Locked → Sliding when the shear spring force exceeds ρN, slipping the way the
 ///   spring was pulled.
-/// - Sliding → Locked when the slip reverses against the assumed direction: friction
-///   would have stopped the vertex within the step.
+/// - Sliding → Locked when the slip increment reverses against the assumed direction:
+///   friction stopped the vertex within the step.
 /// - ρ = 0: a closed contact always slides (there is nothing to hold it).
 /// - Bonded: always Locked.
 pub fn judge(input: &JudgeInput) -> ContactState {
@@ -128,6 +130,7 @@ mod tests {
             normal_force: 100.0,
             friction: 0.5,
             slip_increment: 0.0,
+            slip_velocity: 0.0,
             bonded: false,
             open_tolerance: 1e-9,
             slip_tolerance: 1e-12,

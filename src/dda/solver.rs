@@ -20,6 +20,9 @@ use crate::model::geometry::{self, Point};
 use crate::model::scene::{FixedDirection, GroundKind, Scene};
 use crate::{Error, Result};
 
+/// State changes of one contact within one step after which its state is kept.
+const MAX_FLIPS_PER_STEP: u32 = 4;
+
 /// A constant point load carried by a block.
 #[derive(Debug, Clone)]
 struct PointLoad {
@@ -121,6 +124,8 @@ pub struct Dda {
     energy_scale: f64,
     counters: RunCounters,
     last: StepReport,
+    /// The last step was shortened to land on a contact event.
+    landed: bool,
 }
 
 impl Dda {
@@ -287,6 +292,7 @@ impl Dda {
             energy_scale: 0.0,
             counters: RunCounters::default(),
             last: StepReport::default(),
+            landed: false,
         };
         if model.params.initial_equilibrium {
             model.settle()?;
@@ -459,8 +465,11 @@ impl Dda {
     }
 
     /// Adds the contact terms of the current trial states.
-    fn add_contacts(&self, sys: &mut System, known: &[Vec6]) {
+    fn add_contacts(&self, sys: &mut System, known: &[Vec6], mode: Mode) {
         for c in &self.contacts {
+            if let Mode::Dynamic { dt } = mode {
+                self.add_dashpots(sys, c, dt);
+            }
             let (i, j) = (c.key.vertex_block, c.key.edge_block);
             match c.state {
                 ContactState::Open => {}
@@ -508,6 +517,82 @@ impl Dda {
         }
     }
 
+    /// Dashpot coefficients (normal, shear) of a contact in its trial state.
+    fn dashpot_coefficients(&self, c: &Contact) -> (f64, f64) {
+        let zeta = self.params.contact_damping;
+        if zeta == 0.0 || !c.state.is_closed() {
+            return (0.0, 0.0);
+        }
+        let crit = |p: f64| 2.0 * zeta * (p * c.damping_mass).sqrt();
+        let shear = if c.state == ContactState::Locked {
+            crit(c.props.shear_penalty)
+        } else {
+            0.0
+        };
+        (crit(c.props.normal_penalty), shear)
+    }
+
+    /// Relative velocity along a contact direction: a·v_i + b·v_j.
+    fn directional_velocity(
+        &self,
+        i: usize,
+        a: &Vec6,
+        j: usize,
+        b: &Vec6,
+        vel: &dyn Fn(usize) -> Vec6,
+    ) -> f64 {
+        dot6(a, &vel(i)) + dot6(b, &vel(j))
+    }
+
+    /// Adds the dashpots of a closed contact: force c·q̇ at the generalised-α point, with
+    /// q̇ of a free block from the Newmark velocity update (linear in the increment) and of
+    /// the prescribed ground from its motion.
+    fn add_dashpots(&self, sys: &mut System, c: &Contact, dt: f64) {
+        let (cn, cs) = self.dashpot_coefficients(c);
+        let co = &self.coeffs;
+        let (i, j) = (c.key.vertex_block, c.key.edge_block);
+        for (damping, a, b) in [(cn, &c.gap_i, &c.gap_j), (cs, &c.slip_i, &c.slip_j)] {
+            if damping == 0.0 {
+                continue;
+            }
+            // v_{n+1} = γ/(βΔt)·D + w, w = v(1 − γ/β) + Δt a(1 − γ/(2β)).
+            let mut f0 = 0.0;
+            let mut parts: Vec<(usize, &Vec6)> = Vec::with_capacity(2);
+            for (blk, vec) in [(i, a), (j, b)] {
+                let bl = &self.blocks[blk];
+                match self.dofs.slot[blk] {
+                    Some(_) => {
+                        let mut w = [0.0; 6];
+                        for k in 0..6 {
+                            w[k] = bl.velocity[k] * (1.0 - co.gamma / co.beta)
+                                + dt * bl.accel[k] * (1.0 - co.gamma / (2.0 * co.beta));
+                        }
+                        f0 += damping
+                            * ((1.0 - co.alpha_f) * dot6(vec, &w)
+                                + co.alpha_f * dot6(vec, &bl.velocity));
+                        parts.push((blk, vec));
+                    }
+                    None => {
+                        let v1 = self
+                            .motion
+                            .as_ref()
+                            .map_or(0.0, |m| m.velocity(self.time + dt));
+                        let v_alpha = (1.0 - co.alpha_f) * v1 + co.alpha_f * bl.velocity[0];
+                        f0 += damping * vec[0] * v_alpha;
+                    }
+                }
+            }
+            let k = damping * co.gamma / (co.beta * dt);
+            match parts.as_slice() {
+                [] => {}
+                [p] => sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), None),
+                [p, q, ..] => {
+                    sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), Some((q.0, q.1)))
+                }
+            }
+        }
+    }
+
     /// Runs the open-close iteration. Returns the increments of all blocks and the number
     /// of passes, or `None` if the states did not settle within the allowed passes.
     fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Option<(Vec<Vec6>, usize)>> {
@@ -522,9 +607,13 @@ impl Dda {
         let max_passes = self.params.max_open_close_passes;
         for pass in 1..=max_passes {
             let mut sys = base.clone();
-            self.add_contacts(&mut sys, known);
+            self.add_contacts(&mut sys, known, mode);
             let solution = sys.solve(self.time)?;
             let increments = self.increments(&solution, known);
+            let velocities = match mode {
+                Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
+                Mode::Static => vec![[0.0; 6]; self.blocks.len()],
+            };
             let mut changed = false;
             let mut max_normal = 0.0_f64;
             for c in &self.contacts {
@@ -535,7 +624,10 @@ impl Dda {
                 let dj = &increments[c.key.edge_block];
                 let gap = c.gap_end(di, dj);
                 let slip = c.slip_increment(di, dj);
+                let slip_velocity = dot6(&c.slip_i, &velocities[c.key.vertex_block])
+                    + dot6(&c.slip_j, &velocities[c.key.edge_block]);
                 let normal_force = c.props.normal_penalty * (-gap).max(0.0);
+                c.end_slip_velocity = slip_velocity;
                 let new_state = judge(&JudgeInput {
                     state: c.state,
                     gap,
@@ -550,6 +642,7 @@ impl Dda {
                         c.props.friction
                     },
                     slip_increment: slip,
+                    slip_velocity,
                     bonded: c.props.bonded,
                     open_tolerance,
                     slip_tolerance,
@@ -567,9 +660,23 @@ impl Dda {
                     }
                 }
                 c.friction_normal = n_alpha;
+                // A contact that keeps flipping within one step (stuck ↔ sliding with the
+                // penalty spring's unresolved dynamics on either side of the limit) keeps
+                // its latest state: the step is then decided, at a small cost in accuracy,
+                // instead of being cut down to nothing.
+                if new_state != c.state && c.flips >= MAX_FLIPS_PER_STEP {
+                    continue;
+                }
                 if new_state != c.state {
-                    // A contact that changes state within the step restarts its shear
-                    // spring from the step start only if it was locked then.
+                    c.flips += 1;
+                    if c.state == c.start_state {
+                        c.event_fraction = match mode {
+                            Mode::Dynamic { dt } => {
+                                transition_fraction(c, new_state, gap, slip, slip_velocity, dt)
+                            }
+                            Mode::Static => 1.0,
+                        };
+                    }
                     changed = true;
                     c.state = new_state;
                 }
@@ -579,6 +686,36 @@ impl Dda {
             }
         }
         Ok(None)
+    }
+
+    /// Velocities at the end of a trial step (Newmark update; the prescribed ground's
+    /// from the motion), used to judge slip reversals.
+    fn end_velocities(&self, increments: &[Vec6], dt: f64) -> Vec<Vec6> {
+        let c = &self.coeffs;
+        self.blocks
+            .iter()
+            .zip(increments)
+            .map(|(b, d)| match b.role {
+                BlockRole::PrescribedGround => {
+                    let v = self
+                        .motion
+                        .as_ref()
+                        .map_or(0.0, |m| m.velocity(self.time + dt));
+                    [v, 0.0, 0.0, 0.0, 0.0, 0.0]
+                }
+                _ => {
+                    let mut v = [0.0; 6];
+                    for k in 0..6 {
+                        let a_new = d[k] / (c.beta * dt * dt)
+                            - b.velocity[k] / (c.beta * dt)
+                            - (0.5 / c.beta - 1.0) * b.accel[k];
+                        v[k] =
+                            b.velocity[k] + dt * ((1.0 - c.gamma) * b.accel[k] + c.gamma * a_new);
+                    }
+                    v
+                }
+            })
+            .collect()
     }
 
     /// Increments of all blocks from the solution vector and the known ones.
@@ -681,10 +818,8 @@ impl Dda {
             let di = &increments[c.key.vertex_block];
             let dj = &increments[c.key.edge_block];
             let gap = c.gap_end(di, dj);
-            let shear = match c.state {
-                ContactState::Locked => c.shear0 + c.slip_increment(di, dj),
-                _ => 0.0,
-            };
+            let shear =
+                yield_stretch(c, c.state, gap).unwrap_or(c.shear0 + c.slip_increment(di, dj));
             self.memory.insert(
                 c.key,
                 ContactMemory {
@@ -729,19 +864,42 @@ impl Dda {
             };
             let p = pair.props;
             e += 0.5 * m.normal_force * m.normal_force / p.normal_penalty;
-            if m.state == ContactState::Locked {
-                e += 0.5 * p.shear_penalty * m.shear * m.shear;
-            }
+            e += 0.5 * p.shear_penalty * m.shear * m.shear;
         }
         e
     }
 
     /// Advances one step (of at most `max_dt`), cutting Δt as needed.
     pub fn step(&mut self, max_dt: f64) -> Result<StepReport> {
+        // The step after a landing on a contact event restarts the integrator with the
+        // classic (β = ½, γ = 1) update, whose end-of-step acceleration does not depend on
+        // the old one: the acceleration just jumped (a raft that stops, reverses or hits),
+        // and a second-order scheme would carry the pre-event acceleration into the new
+        // contact forces and misjudge the stick/slip decision right at the event.
+        let scheme = self.coeffs;
+        loop {
+            if self.landed && self.params.restart_after_events {
+                self.coeffs = super::params::Integrator::Classic.coefficients();
+            }
+            let result = self.step_with_current_scheme(max_dt);
+            self.coeffs = scheme;
+            match result {
+                Ok(Some(report)) => return Ok(report),
+                // An event right at the step start: redo the step as a restart.
+                Ok(None) => continue,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// One step with the current coefficients; `Ok(None)` asks for a restart (an event
+    /// at the very start of the step was found).
+    fn step_with_current_scheme(&mut self, max_dt: f64) -> Result<Option<StepReport>> {
         let mut cuts = 0;
         let dt_min = self.params.dt * self.params.min_dt_fraction;
+        let mut dt_override: Option<f64> = None;
         loop {
-            let dt = self.dt_current.min(max_dt);
+            let dt = dt_override.unwrap_or(self.dt_current).min(max_dt);
             let mode = Mode::Dynamic { dt };
             let known = self.known_increments(mode);
             contact::detect(
@@ -752,6 +910,30 @@ impl Dda {
                 &mut self.contacts,
             );
             let outcome = self.iterate(mode, &known)?;
+            // Land the step on a stick-slip (or impact) event: a transition assumed at the
+            // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
+            if let Some((_, _)) = &outcome {
+                if self.params.locate_events && !self.landed && dt_override.is_none() {
+                    let theta = self
+                        .contacts
+                        .iter()
+                        .map(Contact::event_fraction_in_step)
+                        .fold(1.0_f64, f64::min);
+                    if theta * dt <= 1e-6 * self.params.dt {
+                        // The event happened at the step start: restart from here.
+                        self.landed = true;
+                        return Ok(None);
+                    }
+                    if theta < 0.999 {
+                        dt_override = Some(theta * dt);
+                        continue;
+                    }
+                    if theta < 1.0 {
+                        // The event is at this step's end: the next step restarts.
+                        dt_override = Some(dt);
+                    }
+                }
+            }
             let reason = match outcome {
                 None => format!(
                     "the open-close iteration did not settle in {} passes",
@@ -761,9 +943,12 @@ impl Dda {
                     let ratio = self.max_relative_displacement(&increments, &known);
                     if ratio <= self.params.max_displacement_ratio {
                         let report = self.commit_step(dt, &increments, passes, cuts, ratio)?;
+                        // The step after a landing starts at the event: its transition is
+                        // accepted as it comes, so the solver does not creep up on it.
+                        self.landed = dt_override.is_some();
                         // Grow back towards the nominal step after a cut.
                         self.dt_current = (self.dt_current * 1.5).min(self.params.dt);
-                        return Ok(report);
+                        return Ok(Some(report));
                     }
                     format!(
                         "a vertex moved {ratio:.2e} structure sizes in one step (limit {:.2e})",
@@ -771,6 +956,7 @@ impl Dda {
                     )
                 }
             };
+            dt_override = None;
             cuts += 1;
             self.counters.cuts += 1;
             self.dt_current *= self.params.cut_factor;
@@ -798,6 +984,7 @@ impl Dda {
     ) -> Result<StepReport> {
         let c = self.coeffs;
         let t_new = self.time + dt;
+        let start_velocities: Vec<Vec6> = self.blocks.iter().map(|b| b.velocity).collect();
         // Newmark update of velocities and accelerations.
         for (bi, b) in self.blocks.iter_mut().enumerate() {
             match b.role {
@@ -864,11 +1051,31 @@ impl Dda {
                     input += 0.5 * p * (ct.gap0 + gap) * pick(&ct.gap_i, &ct.gap_j);
                     let f = ct.props.friction * ct.friction_normal;
                     input += direction * f * pick(&ct.slip_i, &ct.slip_j);
-                    dissipated += f * slip.abs();
-                    // The stuck shear spring's energy is released when sliding starts.
-                    if ct.start_state == ContactState::Locked {
-                        dissipated += 0.5 * ct.props.shear_penalty * ct.shear0 * ct.shear0;
-                    }
+                    // Plastic slip: the slip minus the change of the spring's elastic stretch.
+                    let elastic = yield_stretch(ct, ct.state, gap).unwrap_or(0.0) - ct.shear0;
+                    dissipated += f * (direction * (slip - elastic)).max(0.0);
+                }
+            }
+        }
+        // Contact dashpots: force c·q̇ at the α point times the relative displacement.
+        let mut damped = 0.0;
+        for ct in &self.contacts {
+            let (cn, cs) = self.dashpot_coefficients(ct);
+            let (i, j) = (ct.key.vertex_block, ct.key.edge_block);
+            for (damping, a, b) in [(cn, &ct.gap_i, &ct.gap_j), (cs, &ct.slip_i, &ct.slip_j)] {
+                if damping == 0.0 {
+                    continue;
+                }
+                let q0 = self.directional_velocity(i, a, j, b, &|k| start_velocities[k]);
+                let q1 = self.directional_velocity(i, a, j, b, &|k| self.blocks[k].velocity);
+                let force = damping * ((1.0 - c.alpha_f) * q1 + c.alpha_f * q0);
+                let dq = dot6(a, &increments[i]) + dot6(b, &increments[j]);
+                damped += force * dq;
+                // The ground side of the dashpot does work on the structure too.
+                if j == g {
+                    input += force * dot6(b, &dg);
+                } else if i == g {
+                    input += force * dot6(a, &dg);
                 }
             }
         }
@@ -920,6 +1127,7 @@ impl Dda {
         self.energy.input_work += input;
         self.energy.external_work += external;
         self.energy.friction_dissipated += dissipated;
+        self.energy.contact_damping += damped;
         self.energy.kinetic = self
             .blocks
             .iter()
@@ -1007,5 +1215,79 @@ impl Dda {
             observe(self, &report);
         }
         Ok(())
+    }
+}
+
+/// Estimates where in a step a contact left its start state (0 = at the start, 1 = at the
+/// end), from the trial solution that showed the change:
+///
+/// - locked → sliding: where the shear force, linear over the step, reaches ρN;
+/// - sliding → locked: where the slip velocity, linear over the step (from its start value
+///   and the slip increment), passes through zero;
+/// - open → closed: where the gap, linear over the step, closes.
+fn transition_fraction(
+    c: &Contact,
+    new_state: ContactState,
+    gap_end: f64,
+    slip: f64,
+    slip_velocity_end: f64,
+    dt: f64,
+) -> f64 {
+    let theta = match (c.state, new_state) {
+        (ContactState::Locked, ContactState::Sliding { .. }) => {
+            let f0 = (c.props.shear_penalty * c.shear0).abs();
+            let f1 = (c.props.shear_penalty * (c.shear0 + slip)).abs();
+            let limit = c.props.friction * c.props.normal_penalty * (-gap_end).max(0.0);
+            if f1 > f0 {
+                (limit - f0) / (f1 - f0)
+            } else {
+                1.0
+            }
+        }
+        (ContactState::Sliding { direction }, ContactState::Locked) => {
+            // The slip velocity, linear over the step, passes through zero.
+            let v0 = c.start_slip_velocity * direction;
+            let v1 = slip_velocity_end * direction;
+            if v0 <= 0.0 {
+                // Already reversing when the step began.
+                0.0
+            } else if v1 < v0 {
+                v0 / (v0 - v1)
+            } else {
+                // Only the displacement reversed: s(τ) = v0 τ + ½ a τ² matches it at dt.
+                let a = 2.0 * (slip * direction - v0 * dt) / (dt * dt);
+                if v0 > 0.0 && a < 0.0 {
+                    -v0 / a / dt
+                } else {
+                    1.0
+                }
+            }
+        }
+        (ContactState::Open, _) if c.gap0 > 0.0 && gap_end < 0.0 => c.gap0 / (c.gap0 - gap_end),
+        _ => 1.0,
+    };
+    if theta.is_finite() {
+        theta.clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
+
+/// The shear spring stretch of a contact that ends the step in `state`: the yield stretch
+/// ±ρN/p_s when sliding, 0 when open, `None` when locked (the stretch is then whatever the
+/// step left).
+fn yield_stretch(c: &Contact, state: ContactState, gap_end: f64) -> Option<f64> {
+    match state {
+        ContactState::Open => Some(0.0),
+        ContactState::Locked => None,
+        ContactState::Sliding { direction } => {
+            let n = c.props.normal_penalty * (-gap_end).max(0.0);
+            let f = if c.props.friction.is_finite() {
+                c.props.friction * n
+            } else {
+                0.0
+            };
+            Some(direction * f / c.props.shear_penalty)
+        }
     }
 }

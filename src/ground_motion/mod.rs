@@ -95,6 +95,15 @@ impl GroundMotion {
         }
     }
 
+    /// Rate of change of the acceleration (jerk) at `t`, m/s³: the derivative of the
+    /// harmonic, or the slope of the record segment that starts at or before `t`.
+    pub fn accel_rate(&self, t: f64) -> f64 {
+        match self {
+            GroundMotion::Harmonic(h) => h.amplitude * h.omega * (h.omega * t).cos(),
+            GroundMotion::Record(r) => r.accel_rate(t),
+        }
+    }
+
     /// Largest |a| over `[0, until]`, m/s² (the paper's a_max).
     pub fn peak_accel(&self, until: f64) -> f64 {
         match self {

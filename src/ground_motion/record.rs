@@ -105,6 +105,15 @@ impl Record {
         }
     }
 
+    /// Slope of the acceleration on the segment containing `t` (right-continuous at
+    /// samples), m/s³. Zero outside the record.
+    pub fn accel_rate(&self, t: f64) -> f64 {
+        match self.locate(t) {
+            Some((k, _)) => (self.accel[k + 1] - self.accel[k]) / self.dt,
+            None => 0.0,
+        }
+    }
+
     /// Velocity at time `t` from rest, m/s (constant after the record ends).
     pub fn velocity(&self, t: f64) -> f64 {
         match self.locate(t) {
