@@ -19,6 +19,8 @@ pub mod analytic;
 pub mod dda;
 pub mod error;
 pub mod ground_motion;
+pub mod headless;
 pub mod model;
+pub mod post;
 
 pub use error::{Error, Result};

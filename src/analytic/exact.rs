@@ -598,12 +598,19 @@ pub fn simulate(
             let g_cur = solver.switching(&cur);
             if g_prev <= 0.0 && g_cur > 0.0 {
                 let f = |x: f64| solver.switching(&at(x));
-                let g_prev_eval = if prev_tau == 0.0 && fresh_slip {
-                    -f64::MIN_POSITIVE
+                let tau_star = if prev_tau == 0.0 && fresh_slip {
+                    // A slip that has just started has u̇_s = 0 at τ = 0; bracket the stop
+                    // from a point just after the start, where the slip is under way.
+                    let a = 1e-6 * tau;
+                    let fa = f(a);
+                    if fa > 0.0 {
+                        a
+                    } else {
+                        solver.root(a, fa, tau, g_cur, &f)
+                    }
                 } else {
-                    g_prev
+                    solver.root(prev_tau, g_prev, tau, g_cur, &f)
                 };
-                let tau_star = solver.root(prev_tau, g_prev_eval, tau, g_cur, &f);
                 let snap = at(tau_star);
                 track_extrema(&solver, &mut peaks, &at, prev_tau, &prev, tau_star, &snap);
                 event = Some((tau_star, snap));
@@ -651,6 +658,10 @@ pub fn simulate(
             }
         }
         result.steps += 1;
+        // Only phases that do not advance time at all count towards the chattering guard.
+        if tau_end > opts.root_tolerance {
+            zero_length_events = 0;
+        }
         if switched {
             // Decide the next phase at the switching time.
             let next = match end.phase {
@@ -681,8 +692,6 @@ pub fn simulate(
                             .into(),
                     });
                 }
-            } else {
-                zero_length_events = 0;
             }
             if next != end.phase {
                 // Peaks on the old side of the switch are counted; now the new side.

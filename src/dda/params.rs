@@ -132,7 +132,7 @@ impl Integrator {
             "trapezoidal" => Integrator::Trapezoidal,
             "hht" => Integrator::Hht { alpha: value(0.1)? },
             "generalized-alpha" | "gen-alpha" => Integrator::GeneralizedAlpha {
-                rho_inf: value(0.5)?,
+                rho_inf: value(0.0)?,
             },
             _ => {
                 return Err(Error::Unknown {

@@ -8,8 +8,12 @@
 //!
 //! Units: SI inside (m/s²); records are stored in g on disk and converted once, at load time.
 
+mod readers;
 mod record;
 
+pub use readers::{
+    builtin_names, builtin_record, parse_at2, parse_text, read_record_file, resolve_record,
+};
 pub use record::Record;
 
 /// Standard gravity, m/s². Records in g are converted with this value.

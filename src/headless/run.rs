@@ -134,24 +134,46 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
     if let Some(d) = req.duration {
         crate::error::require_positive("--duration", d)?;
     }
-    let friction = if req.fixed_base { f64::INFINITY } else { req.friction };
-    let params = TwoBlockParams { alpha: req.alpha, friction, freq_ratio: req.freq_ratio, amplitude_g: req.amplitude_g };
+    let friction = if req.fixed_base {
+        f64::INFINITY
+    } else {
+        req.friction
+    };
+    let params = TwoBlockParams {
+        alpha: req.alpha,
+        friction,
+        freq_ratio: req.freq_ratio,
+        amplitude_g: req.amplitude_g,
+    };
     params.validate()?;
     let mut scene = resolve_scene(&req.scene)?;
     let roles = scene.two_block.clone().ok_or_else(|| {
-        Error::invalid("--scene", format!("scene '{}' is not a two-mass scene (no [two_block] section)", scene.name))
+        Error::invalid(
+            "--scene",
+            format!(
+                "scene '{}' is not a two-mass scene (no [two_block] section)",
+                scene.name
+            ),
+        )
     })?;
     apply_two_block(&mut scene, &params)?;
     let structure_hz = roles.structure_frequency_hz;
     let (motion, omega_ratio, excitation) = match &req.record {
         None => {
             let h = Harmonic::from_g_hz(req.amplitude_g, req.freq_ratio * structure_hz)?;
-            (GroundMotion::Harmonic(h), Some(req.freq_ratio), "harmonic".to_string())
+            (
+                GroundMotion::Harmonic(h),
+                Some(req.freq_ratio),
+                "harmonic".to_string(),
+            )
         }
         Some(name) => {
             let r = resolve_record(name)?;
             let label = r.name.clone();
-            scene.excitation = ExcitationDef::Record { record: name.clone(), scale: 1.0 };
+            scene.excitation = ExcitationDef::Record {
+                record: name.clone(),
+                scale: 1.0,
+            };
             (GroundMotion::Record(std::sync::Arc::new(r)), None, label)
         }
     };
@@ -176,12 +198,23 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
     let a_max = motion.peak_accel(duration);
     let run = match req.model {
         ModelKind::Dda => {
-            let solver = SolverParams { dt: req.dt, duration, integrator: req.integrator, ..SolverParams::default() };
+            let solver = SolverParams {
+                dt: req.dt,
+                duration,
+                integrator: req.integrator,
+                ..SolverParams::default()
+            };
             two_block::run_dda(&scene, &motion, solver, req.record_every)?
         }
-        ModelKind::MassSpring => {
-            two_block::run_exact(req.alpha, structure_hz, friction, &motion, duration, req.dt * req.record_every as f64)?
-        }
+        ModelKind::MassSpring => two_block::run_exact(
+            req.alpha,
+            structure_hz,
+            roles.total_mass,
+            friction,
+            &motion,
+            duration,
+            req.dt * req.record_every as f64,
+        )?,
     };
     let d_scale = omega_ratio.map(|r| {
         let big_omega = 2.0 * std::f64::consts::PI * structure_hz * r;
@@ -192,7 +225,11 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
         model: req.model.label().into(),
         integrator: req.integrator.label(),
         alpha: req.alpha,
-        friction: if req.fixed_base { None } else { Some(req.friction) },
+        friction: if req.fixed_base {
+            None
+        } else {
+            Some(req.friction)
+        },
         fixed_base: req.fixed_base,
         freq_ratio: omega_ratio,
         excitation,
@@ -221,7 +258,9 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
 /// Largest |ground displacement| over [0, duration] (sampled finely enough for a bound).
 fn max_abs_displacement(motion: &GroundMotion, duration: f64) -> f64 {
     let n = 2000;
-    (0..=n).map(|k| motion.displacement(duration * k as f64 / n as f64).abs()).fold(0.0, f64::max)
+    (0..=n)
+        .map(|k| motion.displacement(duration * k as f64 / n as f64).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Writes a run's histories and summary into `dir`.

@@ -50,7 +50,10 @@ pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>> {
         .split(',')
         .map(|s| s.trim())
         .filter(|s| !s.is_empty())
-        .map(|s| s.parse::<f64>().map_err(|_| Error::invalid(flag, format!("'{s}' is not a number"))))
+        .map(|s| {
+            s.parse::<f64>()
+                .map_err(|_| Error::invalid(flag, format!("'{s}' is not a number")))
+        })
         .collect();
     let values = values?;
     if values.is_empty() {
@@ -66,18 +69,29 @@ pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
     if parts.len() != 3 {
         return parse_list(flag, text);
     }
-    let num = |s: &str| s.trim().parse::<f64>().map_err(|_| Error::invalid(flag, format!("'{s}' is not a number")));
+    let num = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .map_err(|_| Error::invalid(flag, format!("'{s}' is not a number")))
+    };
     let (lo, hi) = (num(parts[0])?, num(parts[1])?);
-    let n: usize =
-        parts[2].trim().parse().map_err(|_| Error::invalid(flag, format!("'{}' is not a count", parts[2])))?;
+    let n: usize = parts[2]
+        .trim()
+        .parse()
+        .map_err(|_| Error::invalid(flag, format!("'{}' is not a count", parts[2])))?;
     if !(lo > 0.0 && hi >= lo && lo.is_finite() && hi.is_finite()) || n == 0 {
-        return Err(Error::invalid(flag, "expected lo:hi:n with 0 < lo <= hi and n >= 1"));
+        return Err(Error::invalid(
+            flag,
+            "expected lo:hi:n with 0 < lo <= hi and n >= 1",
+        ));
     }
     if n == 1 {
         return Ok(vec![lo]);
     }
     let (a, b) = (lo.log10(), hi.log10());
-    Ok((0..n).map(|k| 10f64.powf(a + (b - a) * k as f64 / (n - 1) as f64)).collect())
+    Ok((0..n)
+        .map(|k| 10f64.powf(a + (b - a) * k as f64 / (n - 1) as f64))
+        .collect())
 }
 
 impl SweepRequest {
@@ -98,7 +112,10 @@ impl SweepRequest {
 }
 
 /// Runs the grid in parallel (rayon's pool); `tick` is called after each finished run.
-pub fn run_sweep(req: &SweepRequest, tick: &(dyn Fn() + Sync)) -> (Vec<SweepRow>, Vec<SweepFailure>) {
+pub fn run_sweep(
+    req: &SweepRequest,
+    tick: &(dyn Fn() + Sync),
+) -> (Vec<SweepRow>, Vec<SweepFailure>) {
     let results: Vec<std::result::Result<SweepRow, SweepFailure>> = req
         .jobs()
         .par_iter()
@@ -131,7 +148,13 @@ pub fn run_sweep(req: &SweepRequest, tick: &(dyn Fn() + Sync)) -> (Vec<SweepRow>
                     wall_time_s: o.summary.wall_time_s,
                     energy_residual_rel: o.summary.energy_residual_rel,
                 }),
-                Err(e) => Err(SweepFailure { model, alpha, friction, freq_ratio, message: e.to_string() }),
+                Err(e) => Err(SweepFailure {
+                    model,
+                    alpha,
+                    friction,
+                    freq_ratio,
+                    message: e.to_string(),
+                }),
             }
         })
         .collect();
@@ -157,7 +180,10 @@ mod tests {
         assert!((r[0] - 0.1).abs() < 1e-15 && (r[24] - 10.0).abs() < 1e-12);
         assert!((r[12] - 1.0).abs() < 1e-12, "the middle point is resonance");
         assert!(parse_ratios("--freq-ratios", "0:1:3").is_err());
-        assert_eq!(parse_ratios("--freq-ratios", "0.5,2").unwrap(), vec![0.5, 2.0]);
+        assert_eq!(
+            parse_ratios("--freq-ratios", "0.5,2").unwrap(),
+            vec![0.5, 2.0]
+        );
         assert!(parse_list("--alpha", "0.1,x").is_err());
     }
 }

@@ -44,7 +44,10 @@ impl History {
 
     /// A column by name.
     pub fn column(&self, name: &str) -> Option<&[f64]> {
-        self.names.iter().position(|n| n == name).map(|k| self.columns[k].as_slice())
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|k| self.columns[k].as_slice())
     }
 
     /// Writes the table as CSV with a header line.
@@ -54,7 +57,11 @@ impl History {
         let io = |e| Error::io(path, e);
         writeln!(w, "{}", self.names.join(",")).map_err(io)?;
         for row in 0..self.len() {
-            let line: Vec<String> = self.columns.iter().map(|c| format!("{:.9e}", c[row])).collect();
+            let line: Vec<String> = self
+                .columns
+                .iter()
+                .map(|c| format!("{:.9e}", c[row]))
+                .collect();
             writeln!(w, "{}", line.join(",")).map_err(io)?;
         }
         w.flush().map_err(io)

@@ -1,0 +1,350 @@
+//! Command-line definitions (clap) and the glue from flags to the headless functions.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use slidebase::dda::Integrator;
+use slidebase::headless::run::{RunRequest, run, write_outputs};
+use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, run_sweep};
+use slidebase::headless::two_block::ModelKind;
+use slidebase::model::scene::GroundKind;
+
+/// Buildings on a sliding (friction) base under earthquakes, computed with Discontinuous
+/// Deformation Analysis and checked against the exact mass-spring solution.
+#[derive(Debug, Parser)]
+#[command(name = "slidebase", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run one simulation and print its peak responses.
+    Run(RunArgs),
+    /// Run both models over the paper's grid (Figs 4–9) and plot the comparison.
+    Sweep(SweepArgs),
+    /// List the built-in scenes and ground-motion records.
+    List,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ModelArg {
+    /// Discontinuous Deformation Analysis of the blocks.
+    Dda,
+    /// The exact solution of the paper's mass-spring model (Appendix I).
+    MassSpring,
+}
+
+impl From<ModelArg> for ModelKind {
+    fn from(m: ModelArg) -> Self {
+        match m {
+            ModelArg::Dda => ModelKind::Dda,
+            ModelArg::MassSpring => ModelKind::MassSpring,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum GroundArg {
+    /// The ground follows the record exactly (default; no finite-mass error).
+    Prescribed,
+    /// The paper's large ground mass driven by m_g·ü0 (eq. 4).
+    LargeMass,
+}
+
+#[derive(Debug, clap::Args)]
+struct RunArgs {
+    /// Built-in scene name or a scene TOML file.
+    #[arg(long, default_value = "two-block")]
+    scene: String,
+    /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1).
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    alpha: f64,
+    /// Friction coefficient ρ of the sliding joint (≥ 0).
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    friction: f64,
+    /// Excitation frequency over the structure frequency, Ω/ω.
+    #[arg(
+        long = "freq-ratio",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    freq_ratio: f64,
+    /// Amplitude of the harmonic ground acceleration, g.
+    #[arg(
+        long = "amplitude-g",
+        default_value_t = 0.3,
+        allow_negative_numbers = true
+    )]
+    amplitude_g: f64,
+    /// Duration, s (default: 100 s for harmonic input, the record's length for a record).
+    #[arg(long, allow_negative_numbers = true)]
+    duration: Option<f64>,
+    /// Time step, s.
+    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    dt: f64,
+    /// classic | trapezoidal | hht[:α] | generalized-alpha[:ρ∞].
+    #[arg(long, default_value = "generalized-alpha")]
+    integrator: String,
+    /// Which model computes the response.
+    #[arg(long, value_enum, default_value = "dda")]
+    model: ModelArg,
+    /// Fix the base: the sliding joint never slides.
+    #[arg(long)]
+    fixed_base: bool,
+    /// Ground-motion record (built-in name or AT2/CSV file) instead of harmonic input.
+    #[arg(long)]
+    record: Option<String>,
+    /// Ground model of the DDA run.
+    #[arg(long, value_enum)]
+    ground: Option<GroundArg>,
+    /// Write time histories (CSV) and the summary (JSON) into this folder.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct SweepArgs {
+    /// Mass ratios α, comma-separated.
+    #[arg(long, default_value = "0.1,0.5,0.9", allow_hyphen_values = true)]
+    alpha: String,
+    /// Friction coefficients ρ, comma-separated.
+    #[arg(long, default_value = "0.01,0.05,0.1,0.25", allow_hyphen_values = true)]
+    friction: String,
+    /// Frequency ratios: `lo:hi:n` (log-spaced) or a comma-separated list.
+    #[arg(long = "freq-ratios", default_value = "0.1:10:25")]
+    freq_ratios: String,
+    /// Amplitude of the harmonic ground acceleration, g.
+    #[arg(
+        long = "amplitude-g",
+        default_value_t = 0.3,
+        allow_negative_numbers = true
+    )]
+    amplitude_g: f64,
+    /// Duration of each run, s.
+    #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
+    duration: f64,
+    /// DDA time step, s.
+    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    dt: f64,
+    /// DDA integrator.
+    #[arg(long, default_value = "generalized-alpha")]
+    integrator: String,
+    /// Output folder for sweep.csv and the figures.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+}
+
+/// Entry point of the binary.
+pub fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Some(Command::Run(args)) => cmd_run(args),
+        Some(Command::Sweep(args)) => cmd_sweep(args),
+        Some(Command::List) => cmd_list(),
+        None => cmd_default(),
+    }
+}
+
+/// Prints a line to stdout, treating a closed pipe (`| head`) as the end of output.
+fn out(line: &str) -> Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    match writeln!(stdout, "{line}") {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.context("writing to stdout"),
+    }
+}
+
+fn cmd_run(args: RunArgs) -> Result<()> {
+    let req = RunRequest {
+        scene: args.scene,
+        alpha: args.alpha,
+        friction: args.friction,
+        freq_ratio: args.freq_ratio,
+        amplitude_g: args.amplitude_g,
+        duration: args.duration,
+        dt: args.dt,
+        integrator: Integrator::parse(&args.integrator)?,
+        model: args.model.into(),
+        fixed_base: args.fixed_base,
+        record: args.record,
+        ground: args.ground.map(|g| match g {
+            GroundArg::Prescribed => GroundKind::Prescribed,
+            GroundArg::LargeMass => GroundKind::LargeMass,
+        }),
+        record_every: 10,
+    };
+    let outcome = run(&req)?;
+    if let Some(dir) = &args.out {
+        let files = write_outputs(&outcome, dir)?;
+        if !args.json {
+            for f in files {
+                out(&format!("wrote {}", f.display()))?;
+            }
+        }
+    }
+    let s = &outcome.summary;
+    if args.json {
+        return out(&serde_json::to_string(s)?);
+    }
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
+    out(&format!(
+        "{} ({}), α = {}, ρ = {}, {}{}, {:.1} s",
+        s.scene,
+        s.model,
+        s.alpha,
+        s.friction
+            .map_or("∞ (fixed base)".into(), |f| f.to_string()),
+        s.excitation,
+        s.freq_ratio
+            .map_or(String::new(), |r| format!(" Ω/ω = {r:.4}")),
+        s.duration_s
+    ))?;
+    out(&format!(
+        "  |u_s|max/D        {}   ({:.4e} m)",
+        opt(s.us_max_over_d),
+        s.us_max_m
+    ))?;
+    out(&format!(
+        "  |u_r|max/D        {}   ({:.4e} m)",
+        opt(s.ur_max_over_d),
+        s.ur_max_m
+    ))?;
+    out(&format!("  |a_base|max/a_g   {:.4}", s.abase_over_aground))?;
+    out(&format!("  |a_roof|max/a_g   {:.4}", s.aroof_over_aground))?;
+    out(&format!("  residual slip     {:.4e} m", s.residual_slip_m))?;
+    out(&format!(
+        "  {} steps, {} open-close passes, {} Δt cuts, max penetration {:.2e} of size",
+        s.steps, s.open_close_passes, s.dt_cuts, s.max_penetration_ratio
+    ))?;
+    out(&format!(
+        "  energy: input {:.4e} J/m, friction {:.4e} J/m, residual {:.2e} (relative)",
+        s.input_work_j, s.friction_dissipated_j, s.energy_residual_rel
+    ))?;
+    out(&format!("  wall time {:.3} s", s.wall_time_s))
+}
+
+fn cmd_sweep(args: SweepArgs) -> Result<()> {
+    let req = SweepRequest {
+        alphas: parse_list("--alpha", &args.alpha)?,
+        frictions: parse_list("--friction", &args.friction)?,
+        freq_ratios: parse_ratios("--freq-ratios", &args.freq_ratios)?,
+        amplitude_g: args.amplitude_g,
+        duration: args.duration,
+        dt: args.dt,
+        integrator: Integrator::parse(&args.integrator)?,
+        models: vec![ModelKind::MassSpring, ModelKind::Dda],
+    };
+    for &a in &req.alphas {
+        if !(a > 0.0 && a < 1.0) {
+            bail!("invalid --alpha: {a} is outside (0, 1)");
+        }
+    }
+    for &f in &req.frictions {
+        if f.is_nan() || f < 0.0 {
+            bail!("invalid --friction: {f} is negative");
+        }
+    }
+    if !(args.dt > 0.0) || !(args.duration > 0.0) {
+        bail!("invalid --dt/--duration: both must be > 0");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.unwrap_or(0))
+        .build()?;
+    let total = req.jobs().len() as u64;
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let start = std::time::Instant::now();
+    let (rows, failures) = pool.install(|| run_sweep(&req, &|| bar.inc(1)));
+    bar.finish_and_clear();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let csv = args.out.join("sweep.csv");
+    slidebase::post::sweep::write_sweep_csv(&csv, &rows)?;
+    out(&format!(
+        "wrote {} ({} runs in {:.1} s)",
+        csv.display(),
+        rows.len(),
+        start.elapsed().as_secs_f64()
+    ))?;
+    for f in slidebase::post::sweep::plot_paper_figures(&rows, &args.out)? {
+        out(&format!("wrote {}", f.display()))?;
+    }
+    let table = slidebase::post::sweep::error_table(&rows, 0.01);
+    out(&format!(
+        "\nDDA against the exact mass-spring model (relative errors, floor 0.01):\n{table}"
+    ))?;
+    let report = args.out.join("errors.md");
+    std::fs::write(&report, table.to_string())
+        .with_context(|| format!("writing {}", report.display()))?;
+    if !failures.is_empty() {
+        for f in &failures {
+            eprintln!(
+                "failed: {} α={} ρ={} Ω/ω={:.4}: {}",
+                f.model.label(),
+                f.alpha,
+                f.friction,
+                f.freq_ratio,
+                f.message
+            );
+        }
+        bail!("{} of {} runs failed", failures.len(), total);
+    }
+    Ok(())
+}
+
+fn cmd_list() -> Result<()> {
+    out("scenes:")?;
+    for s in slidebase::model::presets::builtin_names() {
+        out(&format!("  {s}"))?;
+    }
+    out("records:")?;
+    for r in slidebase::ground_motion::builtin_names() {
+        out(&format!("  {r}"))?;
+    }
+    Ok(())
+}
+
+/// With no subcommand: the default scene, both models side by side.
+fn cmd_default() -> Result<()> {
+    out("slidebase: two-block scene (paper Fig. 2), α = 0.5, ρ = 0.1, Ω/ω = 1, 0.3 g, 20 s")?;
+    out("           DDA (generalised-α) against the exact mass-spring model\n")?;
+    let mut rows = Vec::new();
+    for model in [ModelKind::MassSpring, ModelKind::Dda] {
+        let req = RunRequest {
+            model,
+            duration: Some(20.0),
+            record_every: 0,
+            ..RunRequest::default()
+        };
+        rows.push(run(&req)?.summary);
+    }
+    out(&format!("  {:<22}{:>14}{:>14}", "", "mass-spring", "DDA"))?;
+    let line = |name: &str, f: &dyn Fn(&slidebase::headless::run::RunSummary) -> f64| {
+        format!("  {:<22}{:>14.4}{:>14.4}", name, f(&rows[0]), f(&rows[1]))
+    };
+    out(&line("|u_s|max/D", &|s| {
+        s.us_max_over_d.unwrap_or(f64::NAN)
+    }))?;
+    out(&line("|u_r|max/D", &|s| {
+        s.ur_max_over_d.unwrap_or(f64::NAN)
+    }))?;
+    out(&line("|a_base|max/a_g", &|s| s.abase_over_aground))?;
+    out(&line("|a_roof|max/a_g", &|s| s.aroof_over_aground))?;
+    out(&line("wall time (s)", &|s| s.wall_time_s))?;
+    out("\nMore: `slidebase run --help`, `slidebase sweep --help`, `slidebase list`.")
+}

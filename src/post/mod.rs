@@ -1,0 +1,5 @@
+//! Post-processing: recorded time histories, spectra, the sweep table and figures.
+
+pub mod history;
+pub mod plot;
+pub mod sweep;

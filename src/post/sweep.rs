@@ -1,0 +1,337 @@
+//! The sweep table (one row per model and grid point), the error table of DDA against the
+//! exact model, and the figures laid out like the paper's Figs 4–9.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::plot::{Figure, Series};
+use crate::{Error, Result};
+
+/// One run of a sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepRow {
+    /// `mass-spring` or `dda`.
+    pub model: String,
+    /// Mass ratio α.
+    pub alpha: f64,
+    /// Friction coefficient ρ.
+    pub friction: f64,
+    /// Ω/ω.
+    pub freq_ratio: f64,
+    /// max|u_s|/D.
+    pub us_max_over_d: f64,
+    /// max|u_r|/D.
+    pub ur_max_over_d: f64,
+    /// max|a_base|/a_g.
+    pub abase_over_aground: f64,
+    /// max|a_roof|/a_g.
+    pub aroof_over_aground: f64,
+    /// Time steps of the run.
+    pub steps: u64,
+    /// Wall-clock time, s.
+    pub wall_time_s: f64,
+    /// Relative energy residual.
+    pub energy_residual_rel: f64,
+}
+
+/// The four metrics by name, in the paper's order.
+pub const METRICS: [&str; 4] = [
+    "us_max_over_d",
+    "ur_max_over_d",
+    "abase_over_aground",
+    "aroof_over_aground",
+];
+
+impl SweepRow {
+    /// A metric by its name in [`METRICS`].
+    pub fn metric(&self, k: usize) -> f64 {
+        match k {
+            0 => self.us_max_over_d,
+            1 => self.ur_max_over_d,
+            2 => self.abase_over_aground,
+            _ => self.aroof_over_aground,
+        }
+    }
+}
+
+/// Writes the rows as CSV with a header.
+pub fn write_sweep_csv(path: &Path, rows: &[SweepRow]) -> Result<()> {
+    let mut w = csv::Writer::from_path(path)
+        .map_err(|e| Error::Scene(format!("{}: {e}", path.display())))?;
+    for r in rows {
+        w.serialize(r)
+            .map_err(|e| Error::Scene(format!("{}: {e}", path.display())))?;
+    }
+    w.flush().map_err(|e| Error::io(path, e))
+}
+
+/// Reads a sweep CSV; errors name the file and line.
+pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
+    let mut r = csv::Reader::from_path(path)
+        .map_err(|e| Error::Scene(format!("{}: {e}", path.display())))?;
+    let mut rows = Vec::new();
+    for rec in r.deserialize::<SweepRow>() {
+        let row = rec.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line() as usize);
+            Error::parse(path.display().to_string(), line, e.to_string())
+        })?;
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// Statistics of one metric's relative errors.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MetricErrors {
+    /// Metric name.
+    pub name: String,
+    /// Matched grid points.
+    pub count: usize,
+    /// Median relative error.
+    pub median: f64,
+    /// 90th percentile.
+    pub p90: f64,
+    /// Largest.
+    pub max: f64,
+    /// Where the largest occurred: (α, ρ, Ω/ω).
+    pub worst: (f64, f64, f64),
+}
+
+/// DDA against the exact model over a sweep.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ErrorTable {
+    /// One entry per metric.
+    pub metrics: Vec<MetricErrors>,
+    /// The floor used in the relative errors (normalised units).
+    pub floor: f64,
+    /// Grid points with a DDA row but no mass-spring row, or the reverse.
+    pub unmatched: usize,
+}
+
+type Key = (u64, u64, u64);
+
+fn key(r: &SweepRow) -> Key {
+    (
+        r.alpha.to_bits(),
+        r.friction.to_bits(),
+        r.freq_ratio.to_bits(),
+    )
+}
+
+/// Value at quantile q of sorted data (linear interpolation).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let pos = q * (sorted.len() - 1) as f64;
+    let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
+    sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64)
+}
+
+/// Relative errors |dda − exact| / max(|exact|, floor) at every matched grid point.
+pub fn error_table(rows: &[SweepRow], floor: f64) -> ErrorTable {
+    let exact: BTreeMap<Key, &SweepRow> = rows
+        .iter()
+        .filter(|r| r.model == "mass-spring")
+        .map(|r| (key(r), r))
+        .collect();
+    let dda: BTreeMap<Key, &SweepRow> = rows
+        .iter()
+        .filter(|r| r.model == "dda")
+        .map(|r| (key(r), r))
+        .collect();
+    let unmatched = exact.keys().filter(|k| !dda.contains_key(k)).count()
+        + dda.keys().filter(|k| !exact.contains_key(k)).count();
+    let mut metrics = Vec::new();
+    for (m, name) in METRICS.iter().enumerate() {
+        let mut errs: Vec<(f64, (f64, f64, f64))> = Vec::new();
+        for (k, d) in &dda {
+            if let Some(e) = exact.get(k) {
+                let (a, b) = (d.metric(m), e.metric(m));
+                let err = (a - b).abs() / b.abs().max(floor);
+                errs.push((
+                    if err.is_finite() { err } else { f64::INFINITY },
+                    (d.alpha, d.friction, d.freq_ratio),
+                ));
+            }
+        }
+        let mut sorted: Vec<f64> = errs.iter().map(|e| e.0).collect();
+        sorted.sort_by(f64::total_cmp);
+        let worst = errs
+            .iter()
+            .copied()
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or((f64::NAN, f64::NAN, f64::NAN), |e| e.1);
+        metrics.push(MetricErrors {
+            name: name.to_string(),
+            count: sorted.len(),
+            median: quantile(&sorted, 0.5),
+            p90: quantile(&sorted, 0.9),
+            max: sorted.last().copied().unwrap_or(f64::NAN),
+            worst,
+        });
+    }
+    ErrorTable {
+        metrics,
+        floor,
+        unmatched,
+    }
+}
+
+impl fmt::Display for ErrorTable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "| metric | points | median | 90th pct | max | worst at (α, ρ, Ω/ω) |"
+        )?;
+        writeln!(f, "|---|---:|---:|---:|---:|---|")?;
+        for m in &self.metrics {
+            writeln!(
+                f,
+                "| {} | {} | {:.3} % | {:.3} % | {:.3} % | ({}, {}, {:.3}) |",
+                m.name,
+                m.count,
+                100.0 * m.median,
+                100.0 * m.p90,
+                100.0 * m.max,
+                m.worst.0,
+                m.worst.1,
+                m.worst.2
+            )?;
+        }
+        writeln!(
+            f,
+            "\nRelative errors |DDA − exact| / max(|exact|, {}).",
+            self.floor
+        )?;
+        if self.unmatched > 0 {
+            writeln!(
+                f,
+                "{} grid points had only one of the two models.",
+                self.unmatched
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes figures laid out like the paper's Figs 4–9: per α, a displacement figure
+/// ((a) |u_s|/D, (b) |u_r|/D) and an acceleration figure ((a) |a_base|/a_g, (b) |a_roof|/a_g)
+/// against Ω/ω on log axes; exact model as lines, DDA as markers, one colour per ρ.
+pub fn plot_paper_figures(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut alphas: Vec<f64> = rows.iter().map(|r| r.alpha).collect();
+    alphas.sort_by(f64::total_cmp);
+    alphas.dedup();
+    let mut frictions: Vec<f64> = rows.iter().map(|r| r.friction).collect();
+    frictions.sort_by(f64::total_cmp);
+    frictions.dedup();
+    let mut files = Vec::new();
+    for (ai, &alpha) in alphas.iter().enumerate() {
+        let fig_no = 4 + 2 * ai;
+        for (kind, metrics, labels) in [
+            (
+                "displacements",
+                [0usize, 1],
+                ["(a) |u_s|max / D", "(b) |u_r|max / D"],
+            ),
+            (
+                "accelerations",
+                [2, 3],
+                ["(a) |a_base|max / a_g", "(b) |a_roof|max / a_g"],
+            ),
+        ] {
+            let n = if kind == "displacements" {
+                fig_no
+            } else {
+                fig_no + 1
+            };
+            let mut fig = Figure::new(
+                format!(
+                    "Fig. {n}: α = {alpha}, DDA (markers) against the exact mass-spring model (lines)"
+                ),
+                1,
+                2,
+            );
+            for (pi, &m) in metrics.iter().enumerate() {
+                let panel = &mut fig.panels[pi];
+                panel.title = labels[pi].to_string();
+                panel.x_label = "Ω/ω".into();
+                panel.y_label = labels[pi].split_once(' ').map_or("", |s| s.1).to_string();
+                panel.x_log = true;
+                panel.y_log = true;
+                for (fi, &rho) in frictions.iter().enumerate() {
+                    for (model, line) in [("mass-spring", true), ("dda", false)] {
+                        let mut pts: Vec<(f64, f64)> = rows
+                            .iter()
+                            .filter(|r| r.alpha == alpha && r.friction == rho && r.model == model)
+                            .map(|r| (r.freq_ratio, r.metric(m)))
+                            .collect();
+                        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        let (x, y): (Vec<f64>, Vec<f64>) = pts.into_iter().unzip();
+                        if x.is_empty() {
+                            continue;
+                        }
+                        panel.series.push(if line {
+                            Series::line(format!("ρ = {rho}"), x, y, fi)
+                        } else {
+                            Series::markers("", x, y, fi)
+                        });
+                    }
+                }
+            }
+            let path = out_dir.join(format!("fig{n}_alpha{alpha}_{kind}.png"));
+            fig.save_png(&path, 1400, 600)?;
+            files.push(path);
+        }
+    }
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(model: &str, ratio: f64, v: f64) -> SweepRow {
+        SweepRow {
+            model: model.into(),
+            alpha: 0.5,
+            friction: 0.1,
+            freq_ratio: ratio,
+            us_max_over_d: v,
+            ur_max_over_d: v,
+            abase_over_aground: v,
+            aroof_over_aground: v,
+            steps: 1,
+            wall_time_s: 0.0,
+            energy_residual_rel: 0.0,
+        }
+    }
+
+    #[test]
+    fn error_table_statistics() {
+        // Ten points with errors 1 %, 2 %, …, 10 %.
+        let mut rows = Vec::new();
+        for k in 1..=10 {
+            let r = k as f64;
+            rows.push(row("mass-spring", r, 1.0));
+            rows.push(row("dda", r, 1.0 + 0.01 * r));
+        }
+        rows.push(row("dda", 99.0, 1.0));
+        let t = error_table(&rows, 0.01);
+        let m = &t.metrics[0];
+        assert_eq!(m.count, 10);
+        assert!((m.median - 0.055).abs() < 1e-12);
+        assert!((m.p90 - 0.091).abs() < 1e-12);
+        assert!((m.max - 0.10).abs() < 1e-12 && m.worst.2 == 10.0);
+        assert_eq!(t.unmatched, 1);
+        // The floor: an exact value of 0 against 0.005 is a 50 % error with floor 0.01.
+        let t = error_table(
+            &[row("mass-spring", 1.0, 0.0), row("dda", 1.0, 0.005)],
+            0.01,
+        );
+        assert!((t.metrics[0].median - 0.5).abs() < 1e-12);
+    }
+}
