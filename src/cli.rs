@@ -63,30 +63,26 @@ struct RunArgs {
     #[arg(long, default_value = "two-block")]
     scene: String,
     /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1).
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     alpha: f64,
     /// Friction coefficient ρ of the sliding joint (≥ 0).
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
     friction: f64,
     /// Excitation frequency over the structure frequency, Ω/ω.
-    #[arg(
-        long = "freq-ratio",
-        default_value_t = 1.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "freq-ratio", default_value_t = 1.0, allow_hyphen_values = true)]
     freq_ratio: f64,
     /// Amplitude of the harmonic ground acceleration, g.
     #[arg(
         long = "amplitude-g",
         default_value_t = 0.3,
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     amplitude_g: f64,
     /// Duration, s (default: 100 s for harmonic input, the record's length for a record).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     duration: Option<f64>,
     /// Time step, s.
-    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
     dt: f64,
     /// classic | trapezoidal | hht[:α] | generalized-alpha[:ρ∞].
     #[arg(long, default_value = "generalized-alpha")]
@@ -126,14 +122,14 @@ struct SweepArgs {
     #[arg(
         long = "amplitude-g",
         default_value_t = 0.3,
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     amplitude_g: f64,
     /// Duration of each run, s.
-    #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
     duration: f64,
     /// DDA time step, s.
-    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
     dt: f64,
     /// DDA integrator.
     #[arg(long, default_value = "generalized-alpha")]
@@ -256,9 +252,8 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
             bail!("invalid --friction: {f} is negative");
         }
     }
-    if !(args.dt > 0.0) || !(args.duration > 0.0) {
-        bail!("invalid --dt/--duration: both must be > 0");
-    }
+    slidebase::error::require_positive("--dt", args.dt)?;
+    slidebase::error::require_positive("--duration", args.duration)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.unwrap_or(0))
         .build()?;

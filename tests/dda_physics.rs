@@ -1,5 +1,7 @@
 //! Physical facts the DDA solver must reproduce on small scenes with known answers.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use slidebase::dda::{Dda, Integrator, SolverParams};
 use slidebase::model::Scene;
 

@@ -167,7 +167,6 @@ pub(crate) fn stick_matrices(b: &ShearBuilding) -> (DMatrix<f64>, DMatrix<f64>) 
         if i + 1 < n {
             let kk = b.storey_stiffnesses[i + 1];
             k[(i, i)] += kk;
-            k[(i + 1, i + 1)] += kk;
             k[(i, i + 1)] -= kk;
             k[(i + 1, i)] -= kk;
         }
@@ -652,10 +651,10 @@ pub fn simulate(
                 })
                 .sum(),
         };
-        if let Phase::Slip { .. } = state.phase {
-            if b.friction.is_finite() {
-                energy.friction_dissipated += b.friction * weight * (end.u_s - state.u_s).abs();
-            }
+        if let Phase::Slip { .. } = state.phase
+            && b.friction.is_finite()
+        {
+            energy.friction_dissipated += b.friction * weight * (end.u_s - state.u_s).abs();
         }
         result.steps += 1;
         // Only phases that do not advance time at all count towards the chattering guard.

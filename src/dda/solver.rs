@@ -654,10 +654,10 @@ impl Dda {
                 // symmetric); iterate until it moves by < 1e-4: the friction force is then
                 // within 1e-4·ρN of the implicit one, far below the accuracy targets, while a
                 // tighter bound only buys passes when the penalty springs ring.
-                if let ContactState::Sliding { .. } = new_state {
-                    if (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha) {
-                        changed = true;
-                    }
+                if let ContactState::Sliding { .. } = new_state
+                    && (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha)
+                {
+                    changed = true;
                 }
                 c.friction_normal = n_alpha;
                 // A contact that keeps flipping within one step (stuck ↔ sliding with the
@@ -912,26 +912,28 @@ impl Dda {
             let outcome = self.iterate(mode, &known)?;
             // Land the step on a stick-slip (or impact) event: a transition assumed at the
             // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
-            if let Some((_, _)) = &outcome {
-                if self.params.locate_events && !self.landed && dt_override.is_none() {
-                    let theta = self
-                        .contacts
-                        .iter()
-                        .map(Contact::event_fraction_in_step)
-                        .fold(1.0_f64, f64::min);
-                    if theta * dt <= 1e-6 * self.params.dt {
-                        // The event happened at the step start: restart from here.
-                        self.landed = true;
-                        return Ok(None);
-                    }
-                    if theta < 0.999 {
-                        dt_override = Some(theta * dt);
-                        continue;
-                    }
-                    if theta < 1.0 {
-                        // The event is at this step's end: the next step restarts.
-                        dt_override = Some(dt);
-                    }
+            if outcome.is_some()
+                && self.params.locate_events
+                && !self.landed
+                && dt_override.is_none()
+            {
+                let theta = self
+                    .contacts
+                    .iter()
+                    .map(Contact::event_fraction_in_step)
+                    .fold(1.0_f64, f64::min);
+                if theta * dt <= 1e-6 * self.params.dt {
+                    // The event happened at the step start: restart from here.
+                    self.landed = true;
+                    return Ok(None);
+                }
+                if theta < 0.999 {
+                    dt_override = Some(theta * dt);
+                    continue;
+                }
+                if theta < 1.0 {
+                    // The event is at this step's end: the next step restarts.
+                    dt_override = Some(dt);
                 }
             }
             let reason = match outcome {

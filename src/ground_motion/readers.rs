@@ -195,14 +195,14 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
             .ok_or_else(|| Error::parse(file_label, k + 1, number_error(fields[0])))?;
         let a = parse_number(fields[1])
             .ok_or_else(|| Error::parse(file_label, k + 1, number_error(fields[1])))?;
-        if let Some(&(_, tp, _)) = rows.last() {
-            if t <= tp {
-                return Err(Error::parse(
-                    file_label,
-                    k + 1,
-                    format!("time {t} does not increase (previous row: {tp})"),
-                ));
-            }
+        if let Some(&(_, tp, _)) = rows.last()
+            && t <= tp
+        {
+            return Err(Error::parse(
+                file_label,
+                k + 1,
+                format!("time {t} does not increase (previous row: {tp})"),
+            ));
         }
         rows.push((k + 1, t, a));
     }
@@ -216,23 +216,24 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
             "a record needs at least two samples",
         ));
     }
-    let (t0, tn) = (rows[0].1, rows[rows.len() - 1].1);
-    let dt = (tn - t0) / (rows.len() - 1) as f64;
-    // Uniform sampling: every time within 1 % of a step of t0 + k·dt (times are often
-    // printed with few digits, so exact equality is not expected).
-    for (k, &(line, t, _)) in rows.iter().enumerate() {
-        let expected = t0 + k as f64 * dt;
-        if (t - expected).abs() > 0.01 * dt {
-            let step = t - rows[k.saturating_sub(1)].1;
+    let t0 = rows[0].1;
+    let first_step = rows[1].1 - t0;
+    // Uniform sampling: every step within 1 % of the first one (times are often printed
+    // with few digits, so exact equality is not expected).
+    for w in rows.windows(2) {
+        let step = w[1].1 - w[0].1;
+        if (step - first_step).abs() > 0.01 * first_step {
             return Err(Error::parse(
                 file_label,
-                line,
+                w[1].0,
                 format!(
-                    "time step is not uniform: {step} s here, {dt} s on average (resample the record first)"
+                    "time step is not uniform: {step} s here, {first_step} s at the start (resample the record first)"
                 ),
             ));
         }
     }
+    // The mean step is the most accurate value when times carry rounding.
+    let dt = (rows[rows.len() - 1].1 - t0) / (rows.len() - 1) as f64;
     let mut accel: Vec<f64> = rows.iter().map(|r| r.2 * STANDARD_GRAVITY).collect();
     if t0.abs() > 0.01 * dt {
         if (t0 - dt).abs() <= 0.01 * dt {

@@ -119,7 +119,7 @@ pub fn run_dda(
             // Columns 1..5 are tracked as ground, slip, drift, base, roof.
             p.offer(t, row[k + 1]);
         }
-        if record_every > 0 && step % record_every == 0 {
+        if record_every > 0 && step.is_multiple_of(record_every) {
             history.push(&row);
         }
         step += 1;

@@ -209,10 +209,10 @@ impl Figure {
         let plot_err = |e: &dyn std::fmt::Display| {
             Error::Scene(format!("{}: cannot draw the figure: {e}", path.display()))
         };
-        if let Some(parent) = path.parent() {
-            if !parent.as_os_str().is_empty() {
-                std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
-            }
+        if let Some(parent) = path.parent()
+            && !parent.as_os_str().is_empty()
+        {
+            std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
         }
         let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(&e))?;

@@ -229,8 +229,12 @@ pub fn plot_paper_figures(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathB
     frictions.sort_by(f64::total_cmp);
     frictions.dedup();
     let mut files = Vec::new();
-    for (ai, &alpha) in alphas.iter().enumerate() {
-        let fig_no = 4 + 2 * ai;
+    for &alpha in &alphas {
+        // The paper's figure numbers for its three mass ratios; other α get their own names.
+        let paper_fig = [(0.1, 4), (0.5, 6), (0.9, 8)]
+            .iter()
+            .find(|(a, _)| (a - alpha).abs() < 1e-12)
+            .map(|p| p.1);
         for (kind, metrics, labels) in [
             (
                 "displacements",
@@ -243,14 +247,16 @@ pub fn plot_paper_figures(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathB
                 ["(a) |a_base|max / a_g", "(b) |a_roof|max / a_g"],
             ),
         ] {
-            let n = if kind == "displacements" {
-                fig_no
-            } else {
-                fig_no + 1
+            let (prefix, title) = match paper_fig {
+                Some(f) => {
+                    let n = if kind == "displacements" { f } else { f + 1 };
+                    (format!("fig{n}_"), format!("Fig. {n}: "))
+                }
+                None => (String::new(), String::new()),
             };
             let mut fig = Figure::new(
                 format!(
-                    "Fig. {n}: α = {alpha}, DDA (markers) against the exact mass-spring model (lines)"
+                    "{title}α = {alpha}, DDA (markers) against the exact mass-spring model (lines)"
                 ),
                 1,
                 2,
@@ -282,7 +288,7 @@ pub fn plot_paper_figures(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathB
                     }
                 }
             }
-            let path = out_dir.join(format!("fig{n}_alpha{alpha}_{kind}.png"));
+            let path = out_dir.join(format!("{prefix}alpha{alpha}_{kind}.png"));
             fig.save_png(&path, 1400, 600)?;
             files.push(path);
         }

@@ -1,0 +1,150 @@
+//! The command line as users and scripts see it: names of flags and JSON keys, files
+//! written, and one-line errors with a non-zero exit code (never a panic).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::process::Command;
+
+fn slidebase(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_slidebase"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn run_json_has_the_documented_keys() {
+    let out = slidebase(&[
+        "run",
+        "--alpha",
+        "0.5",
+        "--friction",
+        "0.1",
+        "--freq-ratio",
+        "2",
+        "--duration",
+        "5",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    for key in [
+        "us_max_over_d",
+        "ur_max_over_d",
+        "abase_over_aground",
+        "aroof_over_aground",
+        "steps",
+        "wall_time_s",
+        "energy_residual_rel",
+    ] {
+        assert!(
+            v.get(key).is_some_and(|x| x.is_number()),
+            "missing or non-numeric {key}: {v}"
+        );
+    }
+    assert_eq!(v["steps"].as_u64().map(|s| s >= 5000), Some(true));
+}
+
+#[test]
+fn mass_spring_model_and_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = slidebase(&[
+        "run",
+        "--model",
+        "mass-spring",
+        "--duration",
+        "3",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("history.csv")).unwrap();
+    assert!(csv.starts_with("time_s,ground_accel_m_s2,slip_m"));
+    assert!(csv.lines().count() > 100);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["model"], "mass-spring");
+}
+
+#[test]
+fn parameter_errors_are_one_line_and_non_zero() {
+    for args in [
+        vec!["run", "--alpha", "1.2"],
+        vec!["run", "--alpha", "0"],
+        vec!["run", "--friction", "-0.5"],
+        vec!["run", "--dt", "0"],
+        vec!["run", "--dt", "-1e-3"],
+        vec!["run", "--scene", "no-such-scene"],
+        vec!["run", "--record", "no-such-record"],
+        vec!["run", "--integrator", "euler"],
+        vec!["sweep", "--alpha", "0.5,1.5", "--out", "/tmp/never"],
+        vec!["sweep", "--freq-ratios", "0:1:3", "--out", "/tmp/never"],
+    ] {
+        let out = slidebase(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: '{err}'");
+        assert!(err.starts_with("error:"), "{args:?}: '{err}'");
+    }
+}
+
+#[test]
+fn bad_record_file_names_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("broken.csv");
+    std::fs::write(&path, "0,0\n0.01,0.1\n0.02,oops\n").unwrap();
+    let out = slidebase(&["run", "--record", path.to_str().unwrap(), "--duration", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("broken.csv:3:") && err.contains("oops"),
+        "{err}"
+    );
+}
+
+#[test]
+fn small_sweep_writes_table_and_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = slidebase(&[
+        "sweep",
+        "--alpha",
+        "0.5",
+        "--friction",
+        "0.1",
+        "--freq-ratios",
+        "0.5:2:3",
+        "--duration",
+        "5",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows = slidebase::post::sweep::read_sweep_csv(&dir.path().join("sweep.csv")).unwrap();
+    assert_eq!(rows.len(), 6, "3 ratios × 2 models");
+    for name in [
+        "fig6_alpha0.5_displacements.png",
+        "fig7_alpha0.5_accelerations.png",
+    ] {
+        let bytes = std::fs::read(dir.path().join(name)).unwrap();
+        assert!(
+            bytes.len() > 10_000 && bytes.starts_with(b"\x89PNG"),
+            "{name}"
+        );
+    }
+    assert!(String::from_utf8_lossy(&out.stdout).contains("us_max_over_d"));
+}
