@@ -272,5 +272,55 @@ pub fn write_outputs(outcome: &RunOutcome, dir: &PathBuf) -> Result<Vec<PathBuf>
     let text = serde_json::to_string_pretty(&outcome.summary)
         .map_err(|e| Error::Scene(format!("cannot serialise the summary: {e}")))?;
     std::fs::write(&json, text).map_err(|e| Error::io(&json, e))?;
-    Ok(vec![csv, json])
+    let mut files = vec![csv, json];
+    if !outcome.run.history.is_empty() {
+        let png = dir.join("history.png");
+        history_figure(outcome).save_png(&png, 1400, 900)?;
+        files.push(png);
+    }
+    Ok(files)
+}
+
+/// Time histories of a run: accelerations, slip and roof drift.
+fn history_figure(outcome: &RunOutcome) -> crate::post::plot::Figure {
+    use crate::post::plot::{Figure, Series};
+    let h = &outcome.run.history;
+    let s = &outcome.summary;
+    let col = |name: &str| h.column(name).map(<[f64]>::to_vec).unwrap_or_default();
+    let t = col("time_s");
+    let g = |v: Vec<f64>| v.into_iter().map(|a| a / STANDARD_GRAVITY).collect::<Vec<f64>>();
+    let mut fig = Figure::new(
+        format!(
+            "{} ({}), α = {}, ρ = {}, {}",
+            s.scene,
+            s.model,
+            s.alpha,
+            s.friction.map_or("∞".into(), |f| f.to_string()),
+            s.excitation
+        ),
+        2,
+        2,
+    );
+    let p = &mut fig.panels[0];
+    p.title = "ground and base acceleration".into();
+    p.x_label = "t (s)".into();
+    p.y_label = "a (g)".into();
+    p.series.push(Series::line("ground", t.clone(), g(col("ground_accel_m_s2")), 6));
+    p.series.push(Series::line("base", t.clone(), g(col("base_accel_m_s2")), 1));
+    let p = &mut fig.panels[1];
+    p.title = "roof acceleration (absolute)".into();
+    p.x_label = "t (s)".into();
+    p.y_label = "a (g)".into();
+    p.series.push(Series::line("roof", t.clone(), g(col("roof_accel_m_s2")), 0));
+    let p = &mut fig.panels[2];
+    p.title = format!("slip of the base u_s (peak {:.3e} m)", s.us_max_m);
+    p.x_label = "t (s)".into();
+    p.y_label = "u_s (m)".into();
+    p.series.push(Series::line("", t.clone(), col("slip_m"), 2));
+    let p = &mut fig.panels[3];
+    p.title = format!("roof drift u_r (peak {:.3e} m)", s.ur_max_m);
+    p.x_label = "t (s)".into();
+    p.y_label = "u_r (m)".into();
+    p.series.push(Series::line("", t, col("roof_drift_m"), 3));
+    fig
 }

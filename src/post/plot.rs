@@ -184,6 +184,10 @@ fn tick_label(v: f64, log: bool) -> String {
         }
     } else {
         let a = v.abs();
+        // Ticks computed as sums of floats land on ±1e-17 instead of 0.
+        if a < 1e-12 {
+            return "0".into();
+        }
         if a != 0.0 && !(1e-3..1e5).contains(&a) {
             format!("{v:.1e}")
         } else {
@@ -292,7 +296,12 @@ fn draw_panel<DB: DrawingBackend>(
             .filter(|&(x, y)| x >= x0 && x <= x1 && y >= y0 && y <= y1 || s.style == Style::Line)
             .collect();
         let anno = match s.style {
-            Style::Line => chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))?,
+            // Thick polylines get miter spikes at sharp turns (dense, noisy histories):
+            // draw those one pixel wide.
+            Style::Line => {
+                let width = if pts.len() > 300 { 1 } else { 2 };
+                chart.draw_series(LineSeries::new(pts, color.stroke_width(width)))?
+            }
             Style::Markers => chart.draw_series(
                 pts.into_iter()
                     .map(|pt| Circle::new(pt, 4, color.stroke_width(2))),
