@@ -288,7 +288,11 @@ fn history_figure(outcome: &RunOutcome) -> crate::post::plot::Figure {
     let s = &outcome.summary;
     let col = |name: &str| h.column(name).map(<[f64]>::to_vec).unwrap_or_default();
     let t = col("time_s");
-    let g = |v: Vec<f64>| v.into_iter().map(|a| a / STANDARD_GRAVITY).collect::<Vec<f64>>();
+    let g = |v: Vec<f64>| {
+        v.into_iter()
+            .map(|a| a / STANDARD_GRAVITY)
+            .collect::<Vec<f64>>()
+    };
     let mut fig = Figure::new(
         format!(
             "{} ({}), α = {}, ρ = {}, {}",
@@ -305,13 +309,28 @@ fn history_figure(outcome: &RunOutcome) -> crate::post::plot::Figure {
     p.title = "ground and base acceleration".into();
     p.x_label = "t (s)".into();
     p.y_label = "a (g)".into();
-    p.series.push(Series::line("ground", t.clone(), g(col("ground_accel_m_s2")), 6));
-    p.series.push(Series::line("base", t.clone(), g(col("base_accel_m_s2")), 1));
+    p.series.push(Series::line(
+        "ground",
+        t.clone(),
+        g(col("ground_accel_m_s2")),
+        6,
+    ));
+    p.series.push(Series::line(
+        "base",
+        t.clone(),
+        g(col("base_accel_m_s2")),
+        1,
+    ));
     let p = &mut fig.panels[1];
     p.title = "roof acceleration (absolute)".into();
     p.x_label = "t (s)".into();
     p.y_label = "a (g)".into();
-    p.series.push(Series::line("roof", t.clone(), g(col("roof_accel_m_s2")), 0));
+    p.series.push(Series::line(
+        "roof",
+        t.clone(),
+        g(col("roof_accel_m_s2")),
+        0,
+    ));
     let p = &mut fig.panels[2];
     p.title = format!("slip of the base u_s (peak {:.3e} m)", s.us_max_m);
     p.x_label = "t (s)".into();
