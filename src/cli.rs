@@ -28,6 +28,8 @@ enum Command {
     Run(RunArgs),
     /// Run both models over the paper's grid (Figs 4–9) and plot the comparison.
     Sweep(SweepArgs),
+    /// Natural frequencies and mode shapes of a building scene (fixed base).
+    Modes(ModesArgs),
     /// List the built-in scenes and ground-motion records.
     List,
 }
@@ -62,15 +64,15 @@ struct RunArgs {
     /// Built-in scene name or a scene TOML file.
     #[arg(long, default_value = "two-block")]
     scene: String,
-    /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1).
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
-    alpha: f64,
-    /// Friction coefficient ρ of the sliding joint (≥ 0).
-    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
-    friction: f64,
-    /// Excitation frequency over the structure frequency, Ω/ω.
-    #[arg(long = "freq-ratio", default_value_t = 1.0, allow_hyphen_values = true)]
-    freq_ratio: f64,
+    /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1) (two-block; default 0.5).
+    #[arg(long, allow_hyphen_values = true)]
+    alpha: Option<f64>,
+    /// Friction coefficient ρ of the sliding joint, ≥ 0 (default: 0.1 two-block, the scene's otherwise).
+    #[arg(long, allow_hyphen_values = true)]
+    friction: Option<f64>,
+    /// Excitation frequency over the structure frequency, Ω/ω (two-block; default 1).
+    #[arg(long = "freq-ratio", allow_hyphen_values = true)]
+    freq_ratio: Option<f64>,
     /// Amplitude of the harmonic ground acceleration, g.
     #[arg(
         long = "amplitude-g",
@@ -103,6 +105,16 @@ struct RunArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct ModesArgs {
+    /// Built-in scene name or a scene TOML file (a building scene).
+    #[arg(long, default_value = "three-storey")]
+    scene: String,
+    /// Print one JSON object.
     #[arg(long)]
     json: bool,
 }
@@ -148,6 +160,7 @@ pub fn main() -> Result<()> {
     match cli.command {
         Some(Command::Run(args)) => cmd_run(args),
         Some(Command::Sweep(args)) => cmd_sweep(args),
+        Some(Command::Modes(args)) => cmd_modes(args),
         Some(Command::List) => cmd_list(),
         None => cmd_default(),
     }
@@ -163,15 +176,20 @@ fn out(line: &str) -> Result<()> {
 }
 
 fn cmd_run(args: RunArgs) -> Result<()> {
+    let integrator = Integrator::parse(&args.integrator)?;
+    let scene = slidebase::model::presets::resolve_scene(&args.scene)?;
+    if scene.structure.is_some() {
+        return cmd_run_frame(args, integrator);
+    }
     let req = RunRequest {
         scene: args.scene,
-        alpha: args.alpha,
-        friction: args.friction,
-        freq_ratio: args.freq_ratio,
+        alpha: args.alpha.unwrap_or(0.5),
+        friction: args.friction.unwrap_or(0.1),
+        freq_ratio: args.freq_ratio.unwrap_or(1.0),
         amplitude_g: args.amplitude_g,
         duration: args.duration,
         dt: args.dt,
-        integrator: Integrator::parse(&args.integrator)?,
+        integrator,
         model: args.model.into(),
         fixed_base: args.fixed_base,
         record: args.record,
@@ -300,6 +318,129 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
         bail!("{} of {} runs failed", failures.len(), total);
     }
     Ok(())
+}
+
+fn cmd_run_frame(args: RunArgs, integrator: Integrator) -> Result<()> {
+    use slidebase::headless::frame::{FrameRequest, run_frame, run_mdof};
+    if args.alpha.is_some() || args.freq_ratio.is_some() {
+        bail!(
+            "invalid --alpha/--freq-ratio: they set up the two-block scene, not '{}'",
+            args.scene
+        );
+    }
+    let req = FrameRequest {
+        scene: args.scene,
+        record: args.record,
+        friction: args.friction,
+        fixed_base: args.fixed_base,
+        dt: args.dt,
+        integrator,
+        duration: args.duration,
+    };
+    let outcome = match args.model {
+        ModelArg::Dda => run_frame(&req)?,
+        ModelArg::MassSpring => run_mdof(&req)?,
+    };
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        outcome.history.write_csv(&dir.join("history.csv"))?;
+        std::fs::write(
+            dir.join("summary.json"),
+            serde_json::to_string_pretty(&outcome.summary)?,
+        )
+        .with_context(|| format!("writing {}", dir.display()))?;
+    }
+    let s = &outcome.summary;
+    if args.json {
+        return out(&serde_json::to_string(s)?);
+    }
+    out(&format!(
+        "{} ({}, {}), {}, {}, {:.2} s",
+        s.scene,
+        s.model,
+        s.integrator,
+        s.record,
+        s.friction
+            .map_or("fixed base".into(), |f| format!("ρ = {f}")),
+        s.duration_s
+    ))?;
+    out(&format!(
+        "  max slip              {:.4} m (residual {:.4} m)",
+        s.max_slip_m, s.residual_slip_m
+    ))?;
+    out(&format!(
+        "  peak roof accel       {:.4} g",
+        s.peak_roof_accel_g
+    ))?;
+    out(&format!(
+        "  peak base accel       {:.4} g  (ground {:.4} g)",
+        s.peak_base_accel_g, s.peak_ground_accel_g
+    ))?;
+    out(&format!(
+        "  peak roof drift       {:.4e} m",
+        s.peak_roof_drift_m
+    ))?;
+    out(&format!(
+        "  base accel spectrum   peak at {:.3} Hz",
+        s.base_accel_peak_freq_hz
+    ))?;
+    out(&format!(
+        "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
+        s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
+    ))
+}
+
+fn cmd_modes(args: ModesArgs) -> Result<()> {
+    use slidebase::headless::frame::{PAPER_FREQUENCIES_HZ, equivalent_mdof};
+    let scene = slidebase::model::presets::resolve_scene(&args.scene)?;
+    let (building, report) = equivalent_mdof(&scene)?;
+    if args.json {
+        let v = serde_json::json!({
+            "scene": report.scene,
+            "frequencies_hz": report.frequencies_hz,
+            "shapes": report.shapes,
+            "levels": report.levels,
+            "paper_frequencies_hz": PAPER_FREQUENCIES_HZ,
+            "mdof": { "raft_mass_kg": building.raft_mass, "storey_masses_kg": building.storey_masses,
+                      "storey_stiffnesses_n_per_m": building.storey_stiffnesses },
+        });
+        return out(&serde_json::to_string(&v)?);
+    }
+    out(&format!(
+        "{}: fixed-base natural frequencies (DDA stiffness and mass)",
+        report.scene
+    ))?;
+    for (k, f) in report.frequencies_hz.iter().enumerate() {
+        let paper = PAPER_FREQUENCIES_HZ.get(k).map_or(String::new(), |p| {
+            format!("   paper {p:.3} Hz ({:+.2} %)", 100.0 * (f / p - 1.0))
+        });
+        let shape: Vec<String> = report.shapes[k]
+            .iter()
+            .map(|x| format!("{x:+.3}"))
+            .collect();
+        out(&format!(
+            "  mode {}: {:.4} Hz{}   shape [{}]",
+            k + 1,
+            f,
+            paper,
+            shape.join(", ")
+        ))?;
+    }
+    out(&format!("  levels: {}", report.levels.join(", ")))?;
+    out(&format!(
+        "equivalent MDOF: raft {:.4e} kg, floors {:?} kg, storey stiffness {:?} N/m",
+        building.raft_mass,
+        building
+            .storey_masses
+            .iter()
+            .map(|m| format!("{m:.4e}"))
+            .collect::<Vec<_>>(),
+        building
+            .storey_stiffnesses
+            .iter()
+            .map(|k| format!("{k:.4e}"))
+            .collect::<Vec<_>>()
+    ))
 }
 
 fn cmd_list() -> Result<()> {

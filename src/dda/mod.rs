@@ -18,4 +18,4 @@ pub mod solver;
 
 pub use energy::EnergyTerms;
 pub use params::{Integrator, SolverParams};
-pub use solver::{Dda, RunCounters, StepReport};
+pub use solver::{Dda, Modes, RunCounters, StepReport};

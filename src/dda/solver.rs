@@ -56,6 +56,15 @@ pub struct StepReport {
     pub energy: EnergyTerms,
 }
 
+/// Natural frequencies and mode shapes (see [`Dda::modes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modes {
+    /// Frequencies, Hz, ascending.
+    pub frequencies_hz: Vec<f64>,
+    /// Mode shapes: per mode, per block, the six unknowns (M-normalised).
+    pub shapes: Vec<Vec<Vec6>>,
+}
+
 /// Totals over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct RunCounters {
@@ -76,8 +85,14 @@ pub struct RunCounters {
 enum Mode {
     /// A dynamic step of size dt.
     Dynamic { dt: f64 },
-    /// Static equilibrium under gravity and loads.
-    Static,
+    /// Static equilibrium under gravity and loads, with every joint's friction coefficient
+    /// replaced by `friction` when given (0: free to slip, ∞: held stuck).
+    Static {
+        /// Friction coefficient used instead of the joints' own.
+        friction: Option<f64>,
+    },
+    /// The bare stiffness, for modal analysis.
+    Modal,
 }
 
 /// Node motion of the current step (for moving joint nodes with their blocks).
@@ -413,7 +428,8 @@ impl Dda {
             Mode::Dynamic { dt } => ((1.0 - c.alpha_m) / (c.beta * dt * dt), 1.0 - c.alpha_f),
             // A vanishing "mass spring" (1 mHz) only so that unloaded rigid-body modes (a
             // roof hung on one bolt can still turn) do not make the static matrix singular.
-            Mode::Static => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
+            Mode::Static { .. } => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
+            Mode::Modal => (0.0, 1.0),
         };
         let mut sys = System::zeros(self.dofs.n, stiffness_factor);
         for (bi, b) in self.blocks.iter().enumerate() {
@@ -505,7 +521,11 @@ impl Dda {
                     );
                     // Friction: −δρN along the slip direction on the vertex, +δρN on the edge;
                     // as generalised forces that is −δρN·(slip_i, slip_j).
-                    let f = -direction * c.props.friction * c.friction_normal;
+                    let friction = match mode {
+                        Mode::Static { friction: Some(f) } => f,
+                        _ => c.props.friction,
+                    };
+                    let f = -direction * friction * c.friction_normal;
                     if let Some(s) = self.dofs.slot[i] {
                         sys.add_rhs(s, &c.slip_i, f);
                     }
@@ -600,7 +620,7 @@ impl Dda {
         let base = self.assemble_base(mode, known, &elements);
         let alpha_f = match mode {
             Mode::Dynamic { .. } => self.coeffs.alpha_f,
-            Mode::Static => 0.0,
+            Mode::Static { .. } | Mode::Modal => 0.0,
         };
         let open_tolerance = 1e-9 * self.structure_size;
         let slip_tolerance = 1e-12 * self.structure_size;
@@ -612,7 +632,7 @@ impl Dda {
             let increments = self.increments(&solution, known);
             let velocities = match mode {
                 Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
-                Mode::Static => vec![[0.0; 6]; self.blocks.len()],
+                Mode::Static { .. } | Mode::Modal => vec![[0.0; 6]; self.blocks.len()],
             };
             let mut changed = false;
             let mut max_normal = 0.0_f64;
@@ -636,10 +656,10 @@ impl Dda {
                     // The static settle holds every joint stuck: it finds the preload of
                     // the normal springs; whether friction can hold the blocks is decided
                     // by the first dynamic step (a block on a steep slope starts sliding).
-                    friction: if matches!(mode, Mode::Static) {
-                        f64::INFINITY
-                    } else {
-                        c.props.friction
+                    friction: match mode {
+                        Mode::Static { friction: Some(f) } => f,
+                        Mode::Modal => f64::INFINITY,
+                        _ => c.props.friction,
                     },
                     slip_increment: slip,
                     slip_velocity,
@@ -674,7 +694,7 @@ impl Dda {
                             Mode::Dynamic { dt } => {
                                 transition_fraction(c, new_state, gap, slip, slip_velocity, dt)
                             }
-                            Mode::Static => 1.0,
+                            Mode::Static { .. } | Mode::Modal => 1.0,
                         };
                     }
                     changed = true;
@@ -736,6 +756,32 @@ impl Dda {
 
     /// Static equilibrium under gravity and loads (the ground does not move).
     fn settle(&mut self) -> Result<()> {
+        // The weight is first let down on joints free to slip: a base slab that spreads
+        // under its load (Poisson) then does not leave the joint's shear springs holding a
+        // self-equilibrated force (at the frame's preload, most of ρN, so that the first
+        // tremor of the ground would make its ends slip). The joints then start stuck with
+        // no shear. Where that has no equilibrium (a block on a slope), the settle is done
+        // with Coulomb's law, and where even that has none (a slope too steep to hold), with
+        // every joint held; the first dynamic step then decides whether they slide.
+        let saved_memory = self.memory.clone();
+        if self.settle_with(Some(0.0)).is_ok() {
+            for m in self.memory.values_mut() {
+                if m.state.is_closed() {
+                    m.state = ContactState::Locked;
+                    m.shear = 0.0;
+                }
+            }
+            return Ok(());
+        }
+        self.memory = saved_memory.clone();
+        if self.settle_with(None).is_ok() {
+            return Ok(());
+        }
+        self.memory = saved_memory;
+        self.settle_with(Some(f64::INFINITY))
+    }
+
+    fn settle_with(&mut self, friction: Option<f64>) -> Result<()> {
         let known = vec![[0.0; 6]; self.blocks.len()];
         contact::detect(
             &self.blocks,
@@ -744,7 +790,7 @@ impl Dda {
             self.search_distance,
             &mut self.contacts,
         );
-        let Some((increments, _)) = self.iterate(Mode::Static, &known)? else {
+        let Some((increments, _)) = self.iterate(Mode::Static { friction }, &known)? else {
             return Err(Error::Solver {
                 time: 0.0,
                 reason:
@@ -1190,6 +1236,106 @@ impl Dda {
         } else {
             0.0
         }
+    }
+
+    /// Natural frequencies and mode shapes of the model about its current state, with every
+    /// touching contact stuck (a fixed base when the joint is closed): the generalised
+    /// eigenproblem K φ = ω² M φ of the tangent stiffness (see [`Dda::tangent_stiffness`])
+    /// and the block mass matrices.
+    pub fn modes(&self) -> Result<Modes> {
+        let model = self.clone();
+        let k = model.tangent_stiffness()?;
+        let mut mass = System::zeros(model.dofs.n, 1.0);
+        for (bi, b) in model.blocks.iter().enumerate() {
+            if let Some(s) = model.dofs.slot[bi] {
+                mass.add_diag_block(s, &b.mass, 1.0);
+            }
+        }
+        let modal = crate::linalg::modal(&mass.k, &k)?;
+        let mut frequencies_hz = Vec::new();
+        let mut shapes = Vec::new();
+        for (col, &w) in modal.omega.iter().enumerate() {
+            frequencies_hz.push(w / (2.0 * std::f64::consts::PI));
+            let shape: Vec<Vec6> = (0..model.blocks.len())
+                .map(|bi| match model.dofs.slot[bi] {
+                    Some(s) => {
+                        let mut d = [0.0; 6];
+                        for k in 0..6 {
+                            d[k] = modal.phi[(s + k, col)];
+                        }
+                        d
+                    }
+                    None => [0.0; 6],
+                })
+                .collect();
+            shapes.push(shape);
+        }
+        Ok(Modes {
+            frequencies_hz,
+            shapes,
+        })
+    }
+
+    /// Out-of-balance force f_ext − f_int at the current state with every touching contact
+    /// stuck: the right-hand side of a static step with zero increment.
+    fn out_of_balance(&mut self) -> DVector<f64> {
+        contact::detect(
+            &self.blocks,
+            &self.pairs,
+            &self.memory,
+            self.search_distance,
+            &mut self.contacts,
+        );
+        for c in &mut self.contacts {
+            if c.gap0 <= 0.0 || c.state.is_closed() {
+                c.state = ContactState::Locked;
+            }
+        }
+        let known = vec![[0.0; 6]; self.blocks.len()];
+        let elements = self.element_terms();
+        let mut sys = self.assemble_base(Mode::Modal, &known, &elements);
+        self.add_contacts(&mut sys, &known, Mode::Modal);
+        sys.r
+    }
+
+    /// Tangent stiffness of the model about its current state: the derivative of the
+    /// internal forces with respect to the unknowns *through the solver's own update* (moved
+    /// vertices, accumulated stresses, re-detected contacts), by central differences.
+    /// Besides the elastic, joint and contact stiffness it contains the geometric stiffness
+    /// of the stresses the model carries — under a heavy gravity preload, the P-Δ softening
+    /// that the time stepping shows and a plain assembly of K would miss.
+    pub fn tangent_stiffness(&self) -> Result<nalgebra::DMatrix<f64>> {
+        let n = self.dofs.n;
+        let mut base = self.clone();
+        base.out_of_balance();
+        let mut k = nalgebra::DMatrix::zeros(n, n);
+        // Perturbations: small against the model (1e-7 of its size for translations, 1e-7
+        // rad, 1e-9 strain) yet far above rounding of the forces they produce.
+        let steps = [
+            1e-7 * self.structure_size,
+            1e-7 * self.structure_size,
+            1e-7,
+            1e-9,
+            1e-9,
+            1e-9,
+        ];
+        for (bi, slot) in self.dofs.slot.iter().enumerate() {
+            let Some(s) = *slot else { continue };
+            for dof in 0..6 {
+                let h = steps[dof];
+                let mut r = [DVector::zeros(0), DVector::zeros(0)];
+                for (side, sign) in [(0, 1.0), (1, -1.0)] {
+                    let mut m = base.clone();
+                    let mut inc = vec![[0.0; 6]; m.blocks.len()];
+                    inc[bi][dof] = sign * h;
+                    m.commit_geometry(&inc)?;
+                    r[side] = m.out_of_balance();
+                }
+                let col = (&r[0] - &r[1]) / (-2.0 * h);
+                k.set_column(s + dof, &col);
+            }
+        }
+        Ok((&k + k.transpose()) * 0.5)
     }
 
     /// Sets the velocity of block `b`'s six unknowns (an initial condition: call before

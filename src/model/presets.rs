@@ -7,10 +7,16 @@ use super::scene::{ExcitationDef, Scene};
 use crate::{Error, Result};
 
 /// The built-in scenes: (name, TOML text).
-const BUILTIN: &[(&str, &str)] = &[(
-    "two-block",
-    include_str!("../../assets/scenes/two-block.toml"),
-)];
+const BUILTIN: &[(&str, &str)] = &[
+    (
+        "two-block",
+        include_str!("../../assets/scenes/two-block.toml"),
+    ),
+    (
+        "three-storey",
+        include_str!("../../assets/scenes/three-storey.toml"),
+    ),
+];
 
 /// Names of the built-in scenes.
 pub fn builtin_names() -> Vec<&'static str> {

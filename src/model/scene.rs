@@ -53,6 +53,21 @@ pub struct Scene {
     /// Roles that let the command line re-parameterise a two-mass scene (α, ρ, Ω/ω).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_block: Option<TwoBlockRoles>,
+    /// Roles of a building scene: which blocks are the base and the floors.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub structure: Option<StructureRoles>,
+}
+
+/// Names the parts of a building so that runs can report slip, drift and floor responses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructureRoles {
+    /// The base slab (the block on the sliding joint).
+    pub base: String,
+    /// The floor slabs, bottom to top; the last one is the roof.
+    pub floors: Vec<String>,
+    /// The sliding joint (contact name).
+    pub joint: String,
 }
 
 fn default_gravity() -> f64 {
@@ -416,6 +431,23 @@ impl Scene {
             }
             ExcitationDef::Record { scale, .. } => {
                 crate::error::require_positive("excitation.scale", *scale)?;
+            }
+        }
+        if let Some(r) = &self.structure {
+            self.block_index(&r.base)?;
+            if r.floors.is_empty() {
+                return Err(Error::Scene(
+                    "structure.floors must name at least one floor".into(),
+                ));
+            }
+            for f in &r.floors {
+                self.block_index(f)?;
+            }
+            if !self.contacts.iter().any(|c| c.name == r.joint) {
+                return Err(Error::Scene(format!(
+                    "structure.joint: no contact named '{}'",
+                    r.joint
+                )));
             }
         }
         if let Some(r) = &self.two_block {

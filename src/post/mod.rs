@@ -2,4 +2,5 @@
 
 pub mod history;
 pub mod plot;
+pub mod spectrum;
 pub mod sweep;
