@@ -30,6 +30,8 @@ enum Command {
     Sweep(SweepArgs),
     /// Natural frequencies and mode shapes of a building scene (fixed base).
     Modes(ModesArgs),
+    /// The paper's seismic case: sliding against fixed base, figures like Figs 10–18.
+    Report(ReportArgs),
     /// List the built-in scenes and ground-motion records.
     List,
 }
@@ -110,6 +112,28 @@ struct RunArgs {
 }
 
 #[derive(Debug, clap::Args)]
+struct ReportArgs {
+    /// Building scene (built-in name or TOML file).
+    #[arg(long, default_value = "three-storey")]
+    scene: String,
+    /// Ground-motion record (default: the scene's, El Centro 1940 NS).
+    #[arg(long)]
+    record: Option<String>,
+    /// Friction coefficient of the sliding joint (default: the scene's, 0.01).
+    #[arg(long, allow_hyphen_values = true)]
+    friction: Option<f64>,
+    /// Time step, s.
+    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
+    dt: f64,
+    /// Duration, s (default: the record's length).
+    #[arg(long, allow_hyphen_values = true)]
+    duration: Option<f64>,
+    /// Output folder.
+    #[arg(long, default_value = "out/report")]
+    out: PathBuf,
+}
+
+#[derive(Debug, clap::Args)]
 struct ModesArgs {
     /// Built-in scene name or a scene TOML file (a building scene).
     #[arg(long, default_value = "three-storey")]
@@ -161,6 +185,7 @@ pub fn main() -> Result<()> {
         Some(Command::Run(args)) => cmd_run(args),
         Some(Command::Sweep(args)) => cmd_sweep(args),
         Some(Command::Modes(args)) => cmd_modes(args),
+        Some(Command::Report(args)) => cmd_report(args),
         Some(Command::List) => cmd_list(),
         None => cmd_default(),
     }
@@ -388,6 +413,27 @@ fn cmd_run_frame(args: RunArgs, integrator: Integrator) -> Result<()> {
         "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
         s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
     ))
+}
+
+fn cmd_report(args: ReportArgs) -> Result<()> {
+    use slidebase::headless::report::{ReportRequest, run_all, write_report};
+    let req = ReportRequest {
+        scene: args.scene,
+        record: args.record,
+        friction: args.friction,
+        dt: args.dt,
+        duration: args.duration,
+    };
+    let bar = ProgressBar::new_spinner();
+    bar.set_message("running sliding and fixed base (DDA, two integrators) and the MDOF model…");
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let runs = run_all(&req);
+    bar.finish_and_clear();
+    let runs = runs?;
+    for f in write_report(&req, &runs, &args.out)? {
+        out(&format!("wrote {}", f.display()))?;
+    }
+    out(&std::fs::read_to_string(args.out.join("summary.md")).unwrap_or_default())
 }
 
 fn cmd_modes(args: ModesArgs) -> Result<()> {

@@ -148,3 +148,67 @@ fn small_sweep_writes_table_and_figures() {
     }
     assert!(String::from_utf8_lossy(&out.stdout).contains("us_max_over_d"));
 }
+
+#[test]
+fn modes_json_and_a_short_report() {
+    let out = slidebase(&["modes", "--scene", "three-storey", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["frequencies_hz"].as_array().map(Vec::len), Some(3));
+    let dir = tempfile::tempdir().unwrap();
+    let out = slidebase(&[
+        "report",
+        "--duration",
+        "3",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for k in 10..=18 {
+        let found = std::fs::read_dir(dir.path()).unwrap().any(|e| {
+            e.unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with(&format!("fig{k}_"))
+        });
+        assert!(found, "fig{k} missing");
+    }
+    let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    assert!(summary.contains("max slip") && summary.contains("paper"));
+    let json = slidebase(&[
+        "run",
+        "--scene",
+        "three-storey",
+        "--duration",
+        "2",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    for key in [
+        "max_slip_m",
+        "residual_slip_m",
+        "peak_roof_accel_g",
+        "peak_base_accel_g",
+        "peak_roof_drift_m",
+        "base_accel_peak_freq_hz",
+        "steps",
+        "wall_time_s",
+        "energy_residual_rel",
+    ] {
+        assert!(
+            v.get(key).is_some_and(serde_json::Value::is_number),
+            "{key}: {v}"
+        );
+    }
+    // Two-block flags make no sense for a building scene.
+    let bad = slidebase(&["run", "--scene", "three-storey", "--alpha", "0.5"]);
+    assert!(!bad.status.success());
+}

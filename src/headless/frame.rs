@@ -540,7 +540,11 @@ pub fn free_vibration_frequencies(
     let mut dda = Dda::new(&scene, None, params)?;
     let base = dda.block_index(&r.base)?;
     let roof = dda.block_index(r.floors.last().map_or(&r.base, |s| s))?;
-    dda.set_velocity(roof, [0.05, 0.0, 0.0, 0.0, 0.0, 0.0])?;
+    // Alternating floor velocities excite all sway modes, not mostly the first.
+    for (k, name) in r.floors.iter().enumerate() {
+        let v = if k % 2 == 0 { 0.05 } else { -0.05 };
+        dda.set_velocity(dda.block_index(name)?, [v, 0.0, 0.0, 0.0, 0.0, 0.0])?;
+    }
     let (mut t, mut drift) = (vec![0.0], vec![0.0]);
     dda.run_until(duration, |d, _| {
         t.push(d.time());

@@ -4,6 +4,7 @@
 //! and never print (printing is the binary's job), so tests and other front ends can use them.
 
 pub mod frame;
+pub mod report;
 pub mod run;
 pub mod sweep;
 pub mod two_block;
