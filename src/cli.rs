@@ -32,6 +32,8 @@ enum Command {
     Modes(ModesArgs),
     /// The paper's seismic case: sliding against fixed base, figures like Figs 10–18.
     Report(ReportArgs),
+    /// Render the scene at one instant into a PNG (offscreen, the visualizer's renderer).
+    Render(RenderArgs),
     /// List the built-in scenes and ground-motion records.
     List,
 }
@@ -112,6 +114,37 @@ struct RunArgs {
 }
 
 #[derive(Debug, clap::Args)]
+struct RenderArgs {
+    /// Scene (built-in name or TOML file).
+    #[arg(long, default_value = "three-storey")]
+    scene: String,
+    /// Record (built-in name or file; default: the scene's).
+    #[arg(long)]
+    record: Option<String>,
+    /// Friction coefficient of the sliding joint.
+    #[arg(long, allow_hyphen_values = true)]
+    friction: Option<f64>,
+    /// Simulated time to show, s.
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    time: f64,
+    /// Output PNG.
+    #[arg(long, default_value = "frame.png")]
+    out: PathBuf,
+    /// Width, pixels.
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    /// Height, pixels.
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Deformation exaggeration factor.
+    #[arg(long, default_value_t = 50.0, allow_hyphen_values = true)]
+    exaggeration: f32,
+    /// Only the sliding model (no fixed-base panel beside it).
+    #[arg(long)]
+    single: bool,
+}
+
+#[derive(Debug, clap::Args)]
 struct ReportArgs {
     /// Building scene (built-in name or TOML file).
     #[arg(long, default_value = "three-storey")]
@@ -186,6 +219,7 @@ pub fn main() -> Result<()> {
         Some(Command::Sweep(args)) => cmd_sweep(args),
         Some(Command::Modes(args)) => cmd_modes(args),
         Some(Command::Report(args)) => cmd_report(args),
+        Some(Command::Render(args)) => cmd_render(args),
         Some(Command::List) => cmd_list(),
         None => cmd_default(),
     }
@@ -415,6 +449,41 @@ fn cmd_run_frame(args: RunArgs, integrator: Integrator) -> Result<()> {
     ))
 }
 
+#[cfg(feature = "gui")]
+fn cmd_render(args: RenderArgs) -> Result<()> {
+    use slidebase::render::offscreen::{PictureOptions, render_run_png};
+    use slidebase::sim::{Excitation, SimConfig};
+    let config = SimConfig {
+        scene: args.scene,
+        friction: args.friction,
+        excitation: args.record.map_or(Excitation::Scene, Excitation::Record),
+        compare_fixed: !args.single,
+        ..SimConfig::default()
+    };
+    let options = PictureOptions {
+        width: args.width,
+        height: args.height,
+        exaggeration: args.exaggeration,
+        ..PictureOptions::default()
+    };
+    let info = render_run_png(&config, args.time, &options, &args.out)?;
+    out(&format!(
+        "wrote {} (t = {:.3} s, {}; simulated in {:.2} s, rendered in {:.3} s)",
+        args.out.display(),
+        info.time,
+        info.adapter,
+        info.simulate_s,
+        info.render_s
+    ))
+}
+
+#[cfg(not(feature = "gui"))]
+fn cmd_render(_args: RenderArgs) -> Result<()> {
+    bail!(
+        "this slidebase was built without the `gui` feature, which `render` needs (build with default features)"
+    )
+}
+
 fn cmd_report(args: ReportArgs) -> Result<()> {
     use slidebase::headless::report::{ReportRequest, run_all, write_report};
     let req = ReportRequest {
@@ -502,6 +571,14 @@ fn cmd_list() -> Result<()> {
 }
 
 /// With no subcommand: the default scene, both models side by side.
+#[cfg(feature = "gui")]
+fn cmd_default() -> Result<()> {
+    slidebase::app::run_app()?;
+    Ok(())
+}
+
+/// Without the visualizer: the default two-block scene, both models side by side.
+#[cfg(not(feature = "gui"))]
 fn cmd_default() -> Result<()> {
     out("slidebase: two-block scene (paper Fig. 2), α = 0.5, ρ = 0.1, Ω/ω = 1, 0.3 g, 20 s")?;
     out("           DDA (generalised-α) against the exact mass-spring model\n")?;

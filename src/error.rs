@@ -58,6 +58,10 @@ pub enum Error {
         known: String,
     },
 
+    /// The platform cannot do what was asked (no display, no graphics adapter…).
+    #[error("{0}")]
+    Platform(String),
+
     /// The solver could not advance: it diverged, hit its Δt floor or produced a non-finite value.
     #[error("solver stopped at t = {time:.6} s: {reason}")]
     Solver {

@@ -16,6 +16,8 @@
 //! The engine never depends on rendering; the visualizer lives behind the `gui` feature.
 
 pub mod analytic;
+#[cfg(feature = "gui")]
+pub mod app;
 pub mod dda;
 pub mod error;
 pub mod ground_motion;
@@ -23,5 +25,10 @@ pub mod headless;
 pub mod linalg;
 pub mod model;
 pub mod post;
+#[cfg(feature = "gui")]
+pub mod render;
+pub mod sim;
+#[cfg(feature = "gui")]
+pub mod ui;
 
 pub use error::{Error, Result};

@@ -1,0 +1,567 @@
+//! The simulation thread: it owns the solvers, runs them ahead of the display and posts
+//! compact frames over a channel; commands come back on a second channel. The UI never
+//! waits on the solver and the solver never waits on the UI.
+//!
+//! A run is the sliding model and, for comparison, the same scene with a bonded joint
+//! (fixed base), advanced in lockstep. Every frame ever computed is posted, so the UI can
+//! keep them all and scrub the timeline.
+
+pub mod frame;
+
+use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+pub use frame::{BlockFrame, ContactFrame, Extractor, ModelFrame, Probes};
+
+use crate::analytic::{ExactOptions, ShearBuilding, simulate};
+use crate::dda::{Dda, Integrator, SolverParams};
+use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
+use crate::model::Scene;
+use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground, resolve_scene};
+use crate::model::scene::ExcitationDef;
+use crate::{Error, Result};
+
+/// The ground motion of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Excitation {
+    /// The scene's own excitation.
+    Scene,
+    /// A record: built-in name or file path.
+    Record(String),
+    /// Harmonic, amplitude in g, frequency as a ratio of the structure's (two-block) or in Hz.
+    Harmonic {
+        /// Amplitude, g.
+        amplitude_g: f64,
+        /// Ω/ω for a two-block scene, Hz otherwise.
+        frequency: f64,
+    },
+}
+
+/// Everything that defines a run; changing any of it restarts the run from t = 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimConfig {
+    /// Built-in scene name or TOML path.
+    pub scene: String,
+    /// Friction coefficient of the sliding joint (None: the scene's).
+    pub friction: Option<f64>,
+    /// Mass ratio α (two-block scenes).
+    pub alpha: Option<f64>,
+    /// Ground motion.
+    pub excitation: Excitation,
+    /// Integrator.
+    pub integrator: Integrator,
+    /// Time step, s.
+    pub dt: f64,
+    /// Also run the fixed-base comparison.
+    pub compare_fixed: bool,
+    /// Duration, s (None: the record's length, or 20 s for harmonic input).
+    pub duration: Option<f64>,
+    /// Simulated time between published frames, s.
+    pub frame_dt: f64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        Self {
+            scene: "three-storey".into(),
+            friction: None,
+            alpha: None,
+            excitation: Excitation::Scene,
+            integrator: Integrator::default(),
+            dt: 1e-3,
+            compare_fixed: true,
+            duration: None,
+            // 100 frames per simulated second: smooth replay at up to 2× speed at 60 Hz,
+            // and about 6 MB for a 30 s three-storey run.
+            frame_dt: 0.01,
+        }
+    }
+}
+
+/// A prepared run: the models, the motion and the metadata the UI needs.
+pub struct PreparedRun {
+    /// The scene as run (after parameters were applied).
+    pub scene: Scene,
+    /// Ground motion.
+    pub motion: GroundMotion,
+    /// Duration, s.
+    pub duration: f64,
+    /// The sliding model and, if requested, the fixed-base one.
+    pub models: Vec<(Dda, Extractor)>,
+    /// For two-block scenes: the exact mass-spring solution (time, slip, drift, base accel,
+    /// roof accel), for overlaying on the DDA curves.
+    pub exact: Option<ExactOverlay>,
+}
+
+/// The exact mass-spring solution of a two-block run, sampled for plotting.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ExactOverlay {
+    /// Times, s.
+    pub time: Vec<f64>,
+    /// Slip, m.
+    pub slip: Vec<f64>,
+    /// Roof drift, m.
+    pub drift: Vec<f64>,
+    /// Absolute base acceleration, m/s².
+    pub base_accel: Vec<f64>,
+    /// Absolute roof acceleration, m/s².
+    pub roof_accel: Vec<f64>,
+}
+
+/// Builds the models of a configuration (shared by the thread, the render command and tests).
+pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
+    crate::error::require_positive("dt", config.dt)?;
+    crate::error::require_positive("frame interval", config.frame_dt)?;
+    let mut scene = resolve_scene(&config.scene)?;
+    if let Some(f) = config.friction
+        && (f.is_nan() || f < 0.0)
+    {
+        return Err(Error::invalid("friction", format!("must be >= 0, got {f}")));
+    }
+    let mut exact = None;
+    let (motion, roles_base, roles_roof, joint) = if let Some(roles) = scene.two_block.clone() {
+        let (amplitude_g, ratio) = match &config.excitation {
+            Excitation::Harmonic {
+                amplitude_g,
+                frequency,
+            } => (*amplitude_g, *frequency),
+            _ => (0.3, 1.0),
+        };
+        let params = TwoBlockParams {
+            alpha: config.alpha.unwrap_or(0.5),
+            friction: config.friction.unwrap_or(0.1),
+            freq_ratio: ratio,
+            amplitude_g,
+        };
+        apply_two_block(&mut scene, &params)?;
+        let motion = match &config.excitation {
+            Excitation::Record(name) => {
+                GroundMotion::Record(std::sync::Arc::new(resolve_record(name)?))
+            }
+            _ => GroundMotion::Harmonic(Harmonic::from_g_hz(
+                amplitude_g,
+                ratio * roles.structure_frequency_hz,
+            )?),
+        };
+        (
+            motion,
+            roles.raft.clone(),
+            roles.roof.clone(),
+            roles.joint.clone(),
+        )
+    } else if let Some(roles) = scene.structure.clone() {
+        if let Some(f) = config.friction {
+            for c in scene.contacts.iter_mut().filter(|c| c.name == roles.joint) {
+                c.friction = f;
+            }
+        }
+        let motion = match &config.excitation {
+            Excitation::Record(name) => {
+                GroundMotion::Record(std::sync::Arc::new(resolve_record(name)?))
+            }
+            Excitation::Harmonic {
+                amplitude_g,
+                frequency,
+            } => GroundMotion::Harmonic(Harmonic::from_g_hz(*amplitude_g, *frequency)?),
+            Excitation::Scene => match &scene.excitation {
+                ExcitationDef::Record { record, scale } => {
+                    let r = resolve_record(record)?;
+                    GroundMotion::Record(std::sync::Arc::new(if *scale != 1.0 {
+                        r.scaled(*scale)?
+                    } else {
+                        r
+                    }))
+                }
+                ExcitationDef::Harmonic {
+                    amplitude_g,
+                    frequency_hz,
+                } => GroundMotion::Harmonic(Harmonic::from_g_hz(*amplitude_g, *frequency_hz)?),
+                ExcitationDef::None => {
+                    return Err(Error::invalid(
+                        "excitation",
+                        "the scene has no ground motion",
+                    ));
+                }
+            },
+        };
+        let roof = roles
+            .floors
+            .last()
+            .cloned()
+            .unwrap_or_else(|| roles.base.clone());
+        (motion, roles.base.clone(), roof, roles.joint.clone())
+    } else {
+        return Err(Error::invalid(
+            "scene",
+            format!(
+                "scene '{}' declares no [two_block] or [structure] roles",
+                scene.name
+            ),
+        ));
+    };
+    let duration = match config.duration {
+        Some(d) => crate::error::require_positive("duration", d)?,
+        None => motion.duration().unwrap_or(20.0),
+    };
+    let travel = (0..=400)
+        .map(|k| motion.displacement(duration * k as f64 / 400.0).abs())
+        .fold(0.0, f64::max);
+    extend_ground(&mut scene, 1.2 * travel + 10.0)?;
+    if let Some(roles) = &scene.two_block {
+        let alpha = config.alpha.unwrap_or(0.5);
+        let b = ShearBuilding::two_mass(
+            alpha,
+            roles.structure_frequency_hz,
+            config.friction.unwrap_or(0.1),
+        )?;
+        let r = simulate(
+            &b,
+            &motion,
+            duration,
+            config.frame_dt,
+            &ExactOptions::default(),
+        )?;
+        exact = Some(ExactOverlay {
+            slip: r.slip.clone(),
+            drift: r.storey_drift[0].clone(),
+            base_accel: r.raft_accel.clone(),
+            roof_accel: r.storey_accel[0].clone(),
+            time: r.time,
+        });
+    }
+    let params = SolverParams {
+        dt: config.dt,
+        duration,
+        integrator: config.integrator,
+        ..SolverParams::default()
+    };
+    let mut models = Vec::new();
+    let variants: &[bool] = if config.compare_fixed {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    for &fixed in variants {
+        let mut s = scene.clone();
+        if fixed {
+            for c in s.contacts.iter_mut().filter(|c| c.name == joint) {
+                c.bonded = true;
+            }
+        }
+        let dda = Dda::new(&s, Some(motion.clone()), params.clone())?;
+        let base = dda.block_index(&roles_base)?;
+        let roof = dda.block_index(&roles_roof)?;
+        let ex = Extractor::new(&dda, base, roof);
+        models.push((dda, ex));
+    }
+    Ok(PreparedRun {
+        scene,
+        motion,
+        duration,
+        models,
+        exact,
+    })
+}
+
+/// A frame of the run: the sliding model and, if run, the fixed-base one, at the same time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameSet {
+    /// Simulated time, s.
+    pub time: f64,
+    /// One frame per model (sliding first).
+    pub models: Vec<ModelFrame>,
+}
+
+/// Messages from the simulation thread. Each carries the generation of the run it belongs
+/// to, so that a UI can drop frames of a run it has already replaced.
+#[derive(Debug, Clone)]
+pub enum SimMessage {
+    /// A run has started.
+    Started {
+        /// Run generation.
+        generation: u64,
+        /// Its configuration.
+        config: Box<SimConfig>,
+        /// Duration, s.
+        duration: f64,
+        /// Model labels ("sliding base", "fixed base").
+        labels: Vec<String>,
+        /// The exact mass-spring overlay (two-block scenes).
+        exact: Option<Box<ExactOverlay>>,
+        /// The first frame (t = 0).
+        first: Box<FrameSet>,
+    },
+    /// New frames, in time order.
+    Frames {
+        /// Run generation.
+        generation: u64,
+        /// Frames.
+        frames: Vec<FrameSet>,
+        /// Simulated seconds per wall-clock second so far.
+        speed: f64,
+        /// Mean time to copy one frame set out of the solvers, µs.
+        extract_us: f64,
+    },
+    /// The run reached its end.
+    Finished {
+        /// Run generation.
+        generation: u64,
+        /// Wall-clock time of the run, s.
+        wall_time_s: f64,
+    },
+    /// The run could not start or stopped with an error.
+    Failed {
+        /// Run generation.
+        generation: u64,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// Commands to the simulation thread.
+#[derive(Debug, Clone)]
+pub enum SimCommand {
+    /// Start (or restart) a run with this configuration.
+    Run(Box<SimConfig>),
+    /// Stop the thread.
+    Quit,
+}
+
+/// The UI's end of the simulation thread.
+pub struct SimHandle {
+    commands: Sender<SimCommand>,
+    /// Messages from the thread.
+    pub messages: Receiver<SimMessage>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl SimHandle {
+    /// Spawns the thread, idle until a [`SimCommand::Run`].
+    pub fn spawn() -> Self {
+        let (commands, command_rx) = channel();
+        let (message_tx, messages) = channel();
+        let thread = std::thread::Builder::new()
+            .name("slidebase-sim".into())
+            .spawn(move || sim_thread(command_rx, message_tx))
+            .ok();
+        Self {
+            commands,
+            messages,
+            thread,
+        }
+    }
+
+    /// Sends a command; returns false if the thread is gone.
+    pub fn send(&self, command: SimCommand) -> bool {
+        self.commands.send(command).is_ok()
+    }
+}
+
+impl Drop for SimHandle {
+    fn drop(&mut self) {
+        let _ = self.commands.send(SimCommand::Quit);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn sim_thread(commands: Receiver<SimCommand>, out: Sender<SimMessage>) {
+    let mut generation = 0u64;
+    let mut pending: Option<SimConfig> = None;
+    loop {
+        let config = match pending.take() {
+            Some(c) => c,
+            None => match commands.recv() {
+                Ok(SimCommand::Run(c)) => *c,
+                Ok(SimCommand::Quit) | Err(_) => return,
+            },
+        };
+        generation += 1;
+        match run_one(generation, &config, &commands, &out) {
+            RunEnd::Finished | RunEnd::Failed => {}
+            RunEnd::Replaced(next) => pending = Some(next),
+            RunEnd::Quit => return,
+        }
+    }
+}
+
+enum RunEnd {
+    Finished,
+    Failed,
+    Replaced(SimConfig),
+    Quit,
+}
+
+fn run_one(
+    generation: u64,
+    config: &SimConfig,
+    commands: &Receiver<SimCommand>,
+    out: &Sender<SimMessage>,
+) -> RunEnd {
+    let start = Instant::now();
+    let mut run = match prepare(config) {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = out.send(SimMessage::Failed {
+                generation,
+                message: e.to_string(),
+            });
+            return RunEnd::Failed;
+        }
+    };
+    let labels = if run.models.len() > 1 {
+        vec!["sliding base".to_string(), "fixed base".to_string()]
+    } else {
+        vec!["sliding base".to_string()]
+    };
+    let first = FrameSet {
+        time: 0.0,
+        models: run
+            .models
+            .iter()
+            .map(|(d, ex)| ex.extract(d, Some(&run.motion)))
+            .collect(),
+    };
+    let _ = out.send(SimMessage::Started {
+        generation,
+        config: Box::new(config.clone()),
+        duration: run.duration,
+        labels,
+        exact: run.exact.take().map(Box::new),
+        first: Box::new(first),
+    });
+    let mut batch = Vec::new();
+    let mut last_send = Instant::now();
+    let (mut extract_total, mut extracted) = (0.0, 0u64);
+    let mut next_frame = config.frame_dt;
+    loop {
+        // Commands first: a new run replaces this one at once.
+        match commands.try_recv() {
+            Ok(SimCommand::Run(c)) => return RunEnd::Replaced(*c),
+            Ok(SimCommand::Quit) | Err(TryRecvError::Disconnected) => return RunEnd::Quit,
+            Err(TryRecvError::Empty) => {}
+        }
+        let target = next_frame.min(run.duration);
+        for (dda, _) in run.models.iter_mut() {
+            if let Err(e) = dda.run_until(target, |_, _| {}) {
+                let _ = out.send(SimMessage::Failed {
+                    generation,
+                    message: e.to_string(),
+                });
+                return RunEnd::Failed;
+            }
+        }
+        let t_extract = Instant::now();
+        batch.push(FrameSet {
+            time: target,
+            models: run
+                .models
+                .iter()
+                .map(|(d, ex)| ex.extract(d, Some(&run.motion)))
+                .collect(),
+        });
+        extract_total += t_extract.elapsed().as_secs_f64();
+        extracted += 1;
+        next_frame += config.frame_dt;
+        let done = target >= run.duration - 1e-12;
+        if done || last_send.elapsed() > Duration::from_millis(30) {
+            let speed = target / start.elapsed().as_secs_f64().max(1e-9);
+            let extract_us = 1e6 * extract_total / extracted.max(1) as f64;
+            let frames = std::mem::take(&mut batch);
+            if out
+                .send(SimMessage::Frames {
+                    generation,
+                    frames,
+                    speed,
+                    extract_us,
+                })
+                .is_err()
+            {
+                return RunEnd::Quit;
+            }
+            last_send = Instant::now();
+        }
+        if done {
+            let _ = out.send(SimMessage::Finished {
+                generation,
+                wall_time_s: start.elapsed().as_secs_f64(),
+            });
+            return RunEnd::Finished;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thread publishes a started message, frames in time order up to the duration,
+    /// and a finished message; a new Run replaces the current one.
+    #[test]
+    fn thread_runs_and_restarts() {
+        let handle = SimHandle::spawn();
+        let config = SimConfig {
+            scene: "two-block".into(),
+            excitation: Excitation::Harmonic {
+                amplitude_g: 0.3,
+                frequency: 1.0,
+            },
+            duration: Some(0.5),
+            frame_dt: 0.05,
+            ..SimConfig::default()
+        };
+        assert!(handle.send(SimCommand::Run(Box::new(config.clone()))));
+        let mut times = Vec::new();
+        let mut started = false;
+        loop {
+            match handle
+                .messages
+                .recv_timeout(Duration::from_secs(60))
+                .unwrap()
+            {
+                SimMessage::Started {
+                    generation,
+                    first,
+                    labels,
+                    exact,
+                    ..
+                } => {
+                    assert_eq!(generation, 1);
+                    assert_eq!(labels.len(), 2);
+                    assert!(exact.is_some());
+                    assert_eq!(first.time, 0.0);
+                    started = true;
+                }
+                SimMessage::Frames { frames, .. } => times.extend(frames.iter().map(|f| f.time)),
+                SimMessage::Finished { .. } => break,
+                SimMessage::Failed { message, .. } => panic!("{message}"),
+            }
+        }
+        assert!(started);
+        assert_eq!(times.len(), 10);
+        assert!((times[9] - 0.5).abs() < 1e-9);
+        assert!(times.windows(2).all(|w| w[1] > w[0]));
+        // A bad configuration is reported, not a panic.
+        let bad = SimConfig {
+            friction: Some(-1.0),
+            ..config
+        };
+        assert!(handle.send(SimCommand::Run(Box::new(bad))));
+        match handle
+            .messages
+            .recv_timeout(Duration::from_secs(60))
+            .unwrap()
+        {
+            SimMessage::Failed {
+                generation,
+                message,
+            } => {
+                assert_eq!(generation, 2);
+                assert!(message.contains("friction"));
+            }
+            other => panic!("expected a failure, got {other:?}"),
+        }
+    }
+}
