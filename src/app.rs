@@ -198,6 +198,18 @@ impl App {
         let paint_jobs = self.egui.tessellate(output.shapes, ppp);
         let tess_ms = t_tess.elapsed().as_secs_f64() * 1e3;
         let t_gpu = Instant::now();
+        // Texture updates first: they must be applied even when this frame is skipped.
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                gfx.egui_renderer
+                    .update_texture(&gfx.device, &gfx.queue, *id, delta);
+            }
+        }
+        for id in &output.textures_delta.free {
+            gfx.egui_renderer.free_texture(id);
+        }
+        let mut textures_delta = output.textures_delta;
+        textures_delta.clear();
         let texture = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -248,12 +260,6 @@ impl App {
             size_in_pixels: [w, h],
             pixels_per_point: ppp,
         };
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                gfx.egui_renderer
-                    .update_texture(&gfx.device, &gfx.queue, *id, delta);
-            }
-        }
         let mut encoder = gfx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -289,9 +295,6 @@ impl App {
         }
         gfx.queue
             .submit(extra.into_iter().chain(std::iter::once(encoder.finish())));
-        for id in &output.textures_delta.free {
-            gfx.egui_renderer.free_texture(id);
-        }
         gfx.window.pre_present_notify();
         gfx.queue.present(texture);
         // SLIDEBASE_PROFILE=1 prints where each frame's time goes (see docs/visualizer.md).

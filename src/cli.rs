@@ -34,6 +34,8 @@ enum Command {
     Report(ReportArgs),
     /// Render the scene at one instant into a PNG (offscreen, the visualizer's renderer).
     Render(RenderArgs),
+    /// Error against run time: time step, integrator, penalty and ground model.
+    Accuracy(AccuracyArgs),
     /// List the built-in scenes and ground-motion records.
     List,
 }
@@ -111,6 +113,16 @@ struct RunArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct AccuracyArgs {
+    /// Output folder.
+    #[arg(long, default_value = "out/accuracy")]
+    out: PathBuf,
+    /// A small version of the study (seconds instead of minutes).
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -220,6 +232,7 @@ pub fn main() -> Result<()> {
         Some(Command::Modes(args)) => cmd_modes(args),
         Some(Command::Report(args)) => cmd_report(args),
         Some(Command::Render(args)) => cmd_render(args),
+        Some(Command::Accuracy(args)) => cmd_accuracy(args),
         Some(Command::List) => cmd_list(),
         None => cmd_default(),
     }
@@ -482,6 +495,25 @@ fn cmd_render(_args: RenderArgs) -> Result<()> {
     bail!(
         "this slidebase was built without the `gui` feature, which `render` needs (build with default features)"
     )
+}
+
+fn cmd_accuracy(args: AccuracyArgs) -> Result<()> {
+    use slidebase::headless::accuracy::{run_accuracy, write_accuracy};
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} (eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let rows = run_accuracy(args.quick, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    let rows = rows?;
+    for f in write_accuracy(&rows, &args.out)? {
+        out(&format!("wrote {}", f.display()))?;
+    }
+    out(&std::fs::read_to_string(args.out.join("report.md")).unwrap_or_default())
 }
 
 fn cmd_report(args: ReportArgs) -> Result<()> {

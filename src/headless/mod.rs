@@ -3,6 +3,7 @@
 //! These functions are what the command line calls; they return plain data and write files,
 //! and never print (printing is the binary's job), so tests and other front ends can use them.
 
+pub mod accuracy;
 pub mod frame;
 pub mod report;
 pub mod run;

@@ -128,8 +128,28 @@ pub struct RunOutcome {
     pub run: TwoBlockRun,
 }
 
-/// Runs one two-mass simulation as requested.
-pub fn run(req: &RunRequest) -> Result<RunOutcome> {
+/// The scene and motion of a two-mass request, ready to run.
+#[derive(Debug, Clone)]
+pub struct TwoBlockSetup {
+    /// The scene with α, ρ, Ω/ω, ground and fixed base applied.
+    pub scene: crate::model::Scene,
+    /// The ground motion.
+    pub motion: GroundMotion,
+    /// Duration, s.
+    pub duration: f64,
+    /// Ω/ω (harmonic input only).
+    pub freq_ratio: Option<f64>,
+    /// `harmonic` or the record name.
+    pub excitation: String,
+    /// The scene's two-mass roles.
+    pub roles: crate::model::scene::TwoBlockRoles,
+    /// Friction actually used (∞ for a fixed base).
+    pub friction: f64,
+}
+
+/// Builds the scene and motion of a two-mass request (shared by `run`, the accuracy and
+/// stability studies).
+pub fn two_block_setup(req: &RunRequest) -> Result<TwoBlockSetup> {
     crate::error::require_positive("--dt", req.dt)?;
     if let Some(d) = req.duration {
         crate::error::require_positive("--duration", d)?;
@@ -195,6 +215,29 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
     if let Some(kind) = req.ground {
         scene.ground.kind = kind;
     }
+    Ok(TwoBlockSetup {
+        scene,
+        motion,
+        duration,
+        freq_ratio: omega_ratio,
+        excitation,
+        roles,
+        friction,
+    })
+}
+
+/// Runs one two-mass simulation as requested.
+pub fn run(req: &RunRequest) -> Result<RunOutcome> {
+    let TwoBlockSetup {
+        scene,
+        motion,
+        duration,
+        freq_ratio: omega_ratio,
+        excitation,
+        roles,
+        friction,
+    } = two_block_setup(req)?;
+    let structure_hz = roles.structure_frequency_hz;
     let a_max = motion.peak_accel(duration);
     let run = match req.model {
         ModelKind::Dda => {
