@@ -36,6 +36,8 @@ enum Command {
     Render(RenderArgs),
     /// Error against run time: time step, integrator, penalty and ground model.
     Accuracy(AccuracyArgs),
+    /// Stiff and extreme cases, each checked against a physical fact.
+    Stability(StabilityArgs),
     /// List the built-in scenes and ground-motion records.
     List,
 }
@@ -113,6 +115,16 @@ struct RunArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct StabilityArgs {
+    /// Output folder.
+    #[arg(long, default_value = "out/stability")]
+    out: PathBuf,
+    /// Leave out the slow cases (the 1000 s run).
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -233,6 +245,7 @@ pub fn main() -> Result<()> {
         Some(Command::Report(args)) => cmd_report(args),
         Some(Command::Render(args)) => cmd_render(args),
         Some(Command::Accuracy(args)) => cmd_accuracy(args),
+        Some(Command::Stability(args)) => cmd_stability(args),
         Some(Command::List) => cmd_list(),
         None => cmd_default(),
     }
@@ -495,6 +508,34 @@ fn cmd_render(_args: RenderArgs) -> Result<()> {
     bail!(
         "this slidebase was built without the `gui` feature, which `render` needs (build with default features)"
     )
+}
+
+fn cmd_stability(args: StabilityArgs) -> Result<()> {
+    use slidebase::headless::stability::{run_stability, write_stability};
+    let rows = run_stability(!args.quick, &|r| {
+        let mark = if r.passed { "ok " } else { "FAIL" };
+        eprintln!(
+            "{mark} {:<40} {}",
+            r.case,
+            if r.finished {
+                r.detail.clone()
+            } else {
+                r.error.clone()
+            }
+        );
+    });
+    for f in write_stability(&rows, &args.out)? {
+        out(&format!("wrote {}", f.display()))?;
+    }
+    let failed = rows.iter().filter(|r| !r.passed).count();
+    if failed > 0 {
+        bail!(
+            "{failed} of {} cases failed their check (see {})",
+            rows.len(),
+            args.out.join("report.md").display()
+        );
+    }
+    Ok(())
 }
 
 fn cmd_accuracy(args: AccuracyArgs) -> Result<()> {

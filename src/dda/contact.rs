@@ -115,10 +115,13 @@ impl Contact {
     }
 
     /// Where in the step (0..1) this contact had an event: the first change of state in
-    /// the open-close iteration, or, for a contact that kept sliding, the zero of its slip
+    /// the open-close iteration (for an open contact, its closing in any pass), or, for a
+    /// contact that kept sliding, the zero of its slip
     /// velocity (linear over the step) when the velocity reversed but the increment not yet.
     pub fn event_fraction_in_step(&self) -> f64 {
-        if self.state != self.start_state {
+        // An impact found in any pass counts even if the contact ends the iteration open
+        // again (it bounced within the step): the step must land on it.
+        if self.state != self.start_state || self.start_state == ContactState::Open {
             return self.event_fraction;
         }
         if let ContactState::Sliding { direction } = self.state {

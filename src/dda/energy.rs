@@ -21,6 +21,10 @@ pub struct EnergyTerms {
     pub friction_dissipated: f64,
     /// Energy dissipated by the contact dashpots (relative motion across closed joints).
     pub contact_damping: f64,
+    /// Energy lost in impacts: contacts that close are taken as plastic impacts (the
+    /// hitting vertex's approach velocity is removed within the step), and the energy the
+    /// impact steps remove is counted here rather than as numerical dissipation.
+    pub impact_dissipated: f64,
 }
 
 impl EnergyTerms {
@@ -32,12 +36,17 @@ impl EnergyTerms {
             - self.strain
             - self.friction_dissipated
             - self.contact_damping
+            - self.impact_dissipated
     }
 
     /// Residual relative to the energy that passed through the system.
     pub fn residual_relative(&self) -> f64 {
         let scale = self.input_work.abs().max(self.external_work.abs()).max(
-            self.kinetic + self.strain.abs() + self.friction_dissipated + self.contact_damping,
+            self.kinetic
+                + self.strain.abs()
+                + self.friction_dissipated
+                + self.contact_damping
+                + self.impact_dissipated,
         );
         if scale > 0.0 {
             self.residual() / scale

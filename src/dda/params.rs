@@ -183,8 +183,10 @@ pub struct SolverParams {
     /// Shorten a step to land on a contact event (stick→slip, slip→stick, impact) found
     /// inside it, so that transitions are not delayed to the step end (O(Δt) → O(Δt²)).
     pub locate_events: bool,
-    /// Take the step after a landed contact event with the classic scheme (see
-    /// `Dda::step`): removes the O(1) misjudgement of stick vs. reversal at the event.
+    /// Restart the integrator at a landed contact event: the classic scheme after a
+    /// stick-slip event (removes the O(1) misjudgement of stick vs. reversal at the event),
+    /// backward Euler at an impact (a plastic impact, restitution 0, instead of the
+    /// elastic or energy-gaining bounce of the penalty spring). See `Dda::step`.
     pub restart_after_events: bool,
     /// Damping ratio ζ of dashpots in parallel with the closed contacts' normal and (when
     /// stuck) shear penalty springs, relative to critical for half the lighter block on the

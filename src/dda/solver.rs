@@ -139,8 +139,35 @@ pub struct Dda {
     energy_scale: f64,
     counters: RunCounters,
     last: StepReport,
-    /// The last step was shortened to land on a contact event.
-    landed: bool,
+    /// How the next step restarts the integrator after a contact event (if at all).
+    restart: Restart,
+}
+
+/// How a step restarts the time integrator after a contact event.
+///
+/// At an event the acceleration jumps (a raft that stops or reverses, a corner that hits
+/// the ground); a second-order scheme carries the old acceleration into the new step and
+/// misjudges the contact right at the event. A restart takes the step with a scheme that
+/// does not use the old acceleration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Restart {
+    /// No event: the chosen integrator.
+    None,
+    /// A stick-slip event: the classic scheme (β = ½, γ = 1), whose end-of-step state does
+    /// not depend on the old acceleration.
+    Event,
+    /// A contact closes (an impact): backward Euler on the velocities (v₁ = v₀ + Δt a₁,
+    /// D = Δt v₁), which brings the approach velocity of the hitting vertex to zero within
+    /// the step — a plastic impact, as of a rigid block on rigid ground (and, for a
+    /// rocking block, exactly Housner's impact: angular momentum about the hitting corner
+    /// is kept). The classic scheme would instead reverse the approach velocity (an elastic
+    /// bounce), and the chosen scheme would add energy with the impulse's acceleration.
+    /// The step after it restarts with [`Restart::AfterImpact`] to flush the impulse.
+    Impact,
+    /// The step after an impact: the classic scheme, like [`Restart::Event`]; the energy
+    /// it removes (the ringing of the springs and blocks just hit) still counts as the
+    /// impact's loss.
+    AfterImpact,
 }
 
 impl Dda {
@@ -307,13 +334,52 @@ impl Dda {
             energy_scale: 0.0,
             counters: RunCounters::default(),
             last: StepReport::default(),
-            landed: false,
+            restart: Restart::None,
         };
+        model.check_initial_overlap()?;
         if model.params.initial_equilibrium {
             model.settle()?;
+        } else {
+            // The stored accelerations (zero) are not those of the initial forces: the
+            // first step restarts, so that it does not depend on them.
+            model.restart = Restart::Event;
         }
         model.reset_reference();
         Ok(model)
+    }
+
+    /// Refuses a scene whose blocks overlap at the start by more than a rounding error of
+    /// the geometry: the penalty springs would throw them apart with an energy the scene
+    /// never had (a vertex 1 cm inside a block on a 1e12 N/m spring stores 50 MJ).
+    fn check_initial_overlap(&mut self) -> Result<()> {
+        let tolerance = 1e-6 * self.structure_size;
+        contact::detect(
+            &self.blocks,
+            &self.pairs,
+            &self.memory,
+            self.search_distance,
+            &mut self.contacts,
+        );
+        let worst = self
+            .contacts
+            .iter()
+            .filter(|c| !c.props.bonded)
+            .min_by(|a, b| a.gap0.total_cmp(&b.gap0));
+        match worst {
+            Some(c) if c.gap0 < -tolerance => Err(Error::Scene(format!(
+                "blocks overlap at the start: vertex {} of block '{}' at ({:.6}, {:.6}) lies \
+                 {:.3e} m inside block '{}' (edge {}); move the blocks apart so that they only \
+                 touch",
+                c.key.vertex,
+                self.blocks[c.key.vertex_block].name,
+                c.point[0],
+                c.point[1],
+                -c.gap0,
+                self.blocks[c.key.edge_block].name,
+                c.key.edge
+            ))),
+            _ => Ok(()),
+        }
     }
 
     /// Simulated time, s.
@@ -622,7 +688,13 @@ impl Dda {
             Mode::Dynamic { .. } => self.coeffs.alpha_f,
             Mode::Static { .. } | Mode::Modal => 0.0,
         };
-        let open_tolerance = 1e-9 * self.structure_size;
+        // A closed contact whose gap opens by less than this stays closed (so that one
+        // resting at zero force does not flicker). Its spring then pulls, by at most
+        // p·tolerance: 1e-12 of the size keeps that tension far below any force of
+        // interest (0.3 mN per metre of size for p = 1e12 N/m; a tolerance of 1e-9 of
+        // the size let a 2 m block hang on 2 kN and held it down past its uplift
+        // threshold), yet well above the rounding of the gap (1e-16 of the size).
+        let open_tolerance = 1e-12 * self.structure_size;
         let slip_tolerance = 1e-12 * self.structure_size;
         let max_passes = self.params.max_open_close_passes;
         for pass in 1..=max_passes {
@@ -635,6 +707,7 @@ impl Dda {
                 Mode::Static { .. } | Mode::Modal => vec![[0.0; 6]; self.blocks.len()],
             };
             let mut changed = false;
+            let mut contradicted = false;
             let mut max_normal = 0.0_f64;
             for c in &self.contacts {
                 max_normal = max_normal.max(c.friction_normal);
@@ -685,6 +758,14 @@ impl Dda {
                 // its latest state: the step is then decided, at a small cost in accuracy,
                 // instead of being cut down to nothing.
                 if new_state != c.state && c.flips >= MAX_FLIPS_PER_STEP {
+                    // ...but never open while penetrating, nor closed while apart: the
+                    // first lets the vertex pass into the other block unopposed (and the
+                    // spring throws it back out with energy it never had), the second
+                    // holds it with a spring in tension. The step is cut instead.
+                    contradicted |= match c.state {
+                        ContactState::Open => gap < 0.0,
+                        _ => gap > open_tolerance,
+                    };
                     continue;
                 }
                 if new_state != c.state {
@@ -700,6 +781,9 @@ impl Dda {
                     changed = true;
                     c.state = new_state;
                 }
+            }
+            if contradicted {
+                return Ok(None);
             }
             if !changed {
                 return Ok(Some((increments, pass)));
@@ -800,16 +884,17 @@ impl Dda {
                         .into(),
             });
         };
-        let ratio = self.max_relative_displacement(&increments, &known);
+        let (block, ratio) = self.most_displaced_block(&increments);
         // Supported blocks settle by millimetres (a roof hung on a 1 Hz spring by 25 cm);
         // an unsupported one falls by g/(2π·1 mHz)² ≈ 250 km on the regularising spring.
         if ratio > 1.0 {
             return Err(Error::Solver {
                 time: 0.0,
                 reason: format!(
-                    "a block moves {:.3} structure sizes to reach equilibrium under gravity: it is \
-                     not supported (no contact, bolt or fixed point holds it)",
-                    ratio
+                    "block '{}' would move {ratio:.3e} structure sizes to reach equilibrium \
+                     under gravity: it is not supported (declare a contact with the block it \
+                     rests on, or a bolt or fixed point that holds it)",
+                    self.blocks[block].name
                 ),
             });
         }
@@ -820,18 +905,27 @@ impl Dda {
     /// Largest vertex displacement of the structure relative to the ground translation,
     /// as a fraction of the structure size.
     fn max_relative_displacement(&self, increments: &[Vec6], _known: &[Vec6]) -> f64 {
+        self.most_displaced_block(increments).1
+    }
+
+    /// The block with the largest vertex displacement relative to the ground translation,
+    /// and that displacement as a fraction of the structure size.
+    fn most_displaced_block(&self, increments: &[Vec6]) -> (usize, f64) {
         let g = increments[self.ground];
-        let mut max = 0.0_f64;
+        let mut max = (self.ground, 0.0_f64);
         for (bi, b) in self.blocks.iter().enumerate() {
             if bi == self.ground {
                 continue;
             }
             for &p in &b.vertices {
                 let u = point_displacement(b.moments.centroid, p, &increments[bi]);
-                max = max.max((u[0] - g[0]).hypot(u[1] - g[1]));
+                let d = (u[0] - g[0]).hypot(u[1] - g[1]);
+                if d > max.1 {
+                    max = (bi, d);
+                }
             }
         }
-        max / self.structure_size
+        (max.0, max.1 / self.structure_size)
     }
 
     /// Moves blocks and joints by the increments and updates the contact memory.
@@ -917,17 +1011,37 @@ impl Dda {
 
     /// Advances one step (of at most `max_dt`), cutting Δt as needed.
     pub fn step(&mut self, max_dt: f64) -> Result<StepReport> {
-        // The step after a landing on a contact event restarts the integrator with the
-        // classic (β = ½, γ = 1) update, whose end-of-step acceleration does not depend on
-        // the old one: the acceleration just jumped (a raft that stops, reverses or hits),
-        // and a second-order scheme would carry the pre-event acceleration into the new
-        // contact forces and misjudge the stick/slip decision right at the event.
+        // The step after a landing on a contact event restarts the integrator (see
+        // [`Restart`]).
         let scheme = self.coeffs;
         loop {
-            if self.landed && self.params.restart_after_events {
-                self.coeffs = super::params::Integrator::Classic.coefficients();
+            let restart = if self.params.restart_after_events {
+                self.restart
+            } else {
+                Restart::None
+            };
+            match restart {
+                Restart::None => {}
+                Restart::Event | Restart::AfterImpact => {
+                    self.coeffs = super::params::Integrator::Classic.coefficients();
+                }
+                Restart::Impact => {
+                    // Newmark β = γ = 1 with the old acceleration taken as zero is backward
+                    // Euler: D = Δt v₀ + Δt² a₁, v₁ = v₀ + Δt a₁.
+                    self.coeffs = AlphaCoefficients {
+                        alpha_m: 0.0,
+                        alpha_f: 0.0,
+                        beta: 1.0,
+                        gamma: 1.0,
+                    };
+                    for b in &mut self.blocks {
+                        if b.role != BlockRole::PrescribedGround {
+                            b.accel = [0.0; 6];
+                        }
+                    }
+                }
             }
-            let result = self.step_with_current_scheme(max_dt);
+            let result = self.step_with_current_scheme(max_dt, restart);
             self.coeffs = scheme;
             match result {
                 Ok(Some(report)) => return Ok(report),
@@ -938,12 +1052,19 @@ impl Dda {
         }
     }
 
-    /// One step with the current coefficients; `Ok(None)` asks for a restart (an event
-    /// at the very start of the step was found).
-    fn step_with_current_scheme(&mut self, max_dt: f64) -> Result<Option<StepReport>> {
+    /// One step with the current coefficients (`restart` says how this step restarts the
+    /// integrator); `Ok(None)` asks for a restart (an event at the very start of the step
+    /// was found).
+    fn step_with_current_scheme(
+        &mut self,
+        max_dt: f64,
+        restart: Restart,
+    ) -> Result<Option<StepReport>> {
         let mut cuts = 0;
         let dt_min = self.params.dt * self.params.min_dt_fraction;
         let mut dt_override: Option<f64> = None;
+        // How the step after this one restarts, when this one is landed on an event.
+        let mut event_kind = Restart::Event;
         loop {
             let dt = dt_override.unwrap_or(self.dt_current).min(max_dt);
             let mode = Mode::Dynamic { dt };
@@ -958,26 +1079,37 @@ impl Dda {
             let outcome = self.iterate(mode, &known)?;
             // Land the step on a stick-slip (or impact) event: a transition assumed at the
             // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
-            if outcome.is_some()
-                && self.params.locate_events
-                && !self.landed
-                && dt_override.is_none()
-            {
-                let theta = self
+            // A restart step accepts the stick-slip transitions it meets (it starts at one,
+            // and must not creep up on it) but still lands on a further impact: a contact
+            // that closes inside a backward-Euler step would leave it with the velocity
+            // that closes the gap, which the next step would turn into a bounce.
+            if outcome.is_some() && self.params.locate_events && dt_override.is_none() {
+                let (theta, impact) = self
                     .contacts
                     .iter()
-                    .map(Contact::event_fraction_in_step)
-                    .fold(1.0_f64, f64::min);
-                if theta * dt <= 1e-6 * self.params.dt {
+                    .map(|c| {
+                        let theta = c.event_fraction_in_step();
+                        (theta, c.start_state == ContactState::Open && theta < 1.0)
+                    })
+                    .filter(|&(_, impact)| restart == Restart::None || impact)
+                    .fold((1.0_f64, false), |a, b| if b.0 < a.0 { b } else { a });
+                event_kind = if impact {
+                    Restart::Impact
+                } else {
+                    Restart::Event
+                };
+                let at_start = theta * dt <= 1e-6 * self.params.dt;
+                if at_start && restart == Restart::None {
                     // The event happened at the step start: restart from here.
-                    self.landed = true;
+                    self.restart = event_kind;
                     return Ok(None);
                 }
-                if theta < 0.999 {
+                // (In a restart step, an impact at its very start is part of this step.)
+                if !at_start && theta < 0.999 {
                     dt_override = Some(theta * dt);
                     continue;
                 }
-                if theta < 1.0 {
+                if !at_start && theta < 1.0 {
                     // The event is at this step's end: the next step restarts.
                     dt_override = Some(dt);
                 }
@@ -990,10 +1122,30 @@ impl Dda {
                 Some((increments, passes)) => {
                     let ratio = self.max_relative_displacement(&increments, &known);
                     if ratio <= self.params.max_displacement_ratio {
-                        let report = self.commit_step(dt, &increments, passes, cuts, ratio)?;
+                        let report = self.commit_step(
+                            dt,
+                            &increments,
+                            passes,
+                            cuts,
+                            ratio,
+                            matches!(restart, Restart::Impact | Restart::AfterImpact),
+                        )?;
                         // The step after a landing starts at the event: its transition is
-                        // accepted as it comes, so the solver does not creep up on it.
-                        self.landed = dt_override.is_some();
+                        // accepted as it comes, so the solver does not creep up on it. An
+                        // impact step is followed by a classic restart, which does not
+                        // carry the impulse's acceleration on; so is a step in which a
+                        // contact opened (its force dropped within the step, and the old
+                        // acceleration would ring on as a decaying energy error).
+                        let opened = self
+                            .contacts
+                            .iter()
+                            .any(|c| c.start_state.is_closed() && c.state == ContactState::Open);
+                        self.restart = match (dt_override.is_some(), restart) {
+                            (true, _) => event_kind,
+                            (false, Restart::Impact) => Restart::AfterImpact,
+                            (false, _) if opened => Restart::Event,
+                            (false, _) => Restart::None,
+                        };
                         // Grow back towards the nominal step after a cut.
                         self.dt_current = (self.dt_current * 1.5).min(self.params.dt);
                         return Ok(Some(report));
@@ -1022,6 +1174,8 @@ impl Dda {
     }
 
     /// Accepts a converged step: integrator update, energy bookkeeping, geometry.
+    /// `impact`: the step is a plastic impact (or the step right after one), and the
+    /// energy it removes is counted as impact loss.
     fn commit_step(
         &mut self,
         dt: f64,
@@ -1029,7 +1183,9 @@ impl Dda {
         passes: usize,
         cuts: usize,
         ratio: f64,
+        impact: bool,
     ) -> Result<StepReport> {
+        let residual_before = self.energy.residual();
         let c = self.coeffs;
         let t_new = self.time + dt;
         let start_velocities: Vec<Vec6> = self.blocks.iter().map(|b| b.velocity).collect();
@@ -1184,10 +1340,17 @@ impl Dda {
             .map(|(_, b)| b.kinetic_energy())
             .sum();
         self.energy.strain = self.stored_energy() - self.stored_reference;
-        self.energy_scale = self
-            .energy_scale
-            .max(self.energy.input_work.abs())
-            .max(self.energy.kinetic + self.energy.strain.abs() + self.energy.friction_dissipated);
+        if impact {
+            // What this step lost beyond friction and dashpots is the impact's loss (signed:
+            // keeping only the losses would bias the residual of many small impacts).
+            self.energy.impact_dissipated += self.energy.residual() - residual_before;
+        }
+        self.energy_scale = self.energy_scale.max(self.energy.input_work.abs()).max(
+            self.energy.kinetic
+                + self.energy.strain.abs()
+                + self.energy.friction_dissipated
+                + self.energy.impact_dissipated,
+        );
         let residual_rel = if self.energy_scale > 0.0 {
             self.energy.residual().abs() / self.energy_scale
         } else {

@@ -7,5 +7,6 @@ pub mod accuracy;
 pub mod frame;
 pub mod report;
 pub mod run;
+pub mod stability;
 pub mod sweep;
 pub mod two_block;

@@ -62,6 +62,9 @@ pub struct TwoBlockRun {
     pub passes: u64,
     /// Δt cuts (DDA only).
     pub cuts: u64,
+    /// Steps that ended with a sliding contact (DDA only; the exact model reports its
+    /// slip phases through the slip history).
+    pub sliding_steps: u64,
     /// Largest penetration / structure size (DDA only).
     pub max_penetration_ratio: f64,
     /// Energy residual relative to the energy that passed through the structure.
@@ -108,7 +111,11 @@ pub fn run_dda(
     let mut history = History::new(&HISTORY_COLUMNS);
     let mut step = 0usize;
     let mut last_slip = 0.0;
-    dda.run_until(duration, |d, _| {
+    let mut sliding_steps = 0;
+    dda.run_until(duration, |d, report| {
+        if report.sliding > 0 {
+            sliding_steps += 1;
+        }
         let t = d.time();
         let b = &d.blocks()[raft];
         let r = &d.blocks()[roof];
@@ -140,6 +147,7 @@ pub fn run_dda(
         steps: counters.steps,
         passes: counters.passes,
         cuts: counters.cuts,
+        sliding_steps,
         max_penetration_ratio: counters.max_penetration_ratio,
         energy_residual_rel: dda.energy_residual_relative(),
         input_work: energy.input_work,
@@ -197,6 +205,7 @@ pub fn run_exact(
         steps: r.steps,
         passes: 0,
         cuts: 0,
+        sliding_steps: 0,
         max_penetration_ratio: 0.0,
         energy_residual_rel: if e.input_work.abs() > 0.0 {
             e.residual / e.input_work.abs()

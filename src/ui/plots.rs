@@ -237,6 +237,15 @@ pub fn plots_ui(state: &AppState, ui: &mut egui::Ui) {
                         p.line(line("kinetic", e(|x| x.kinetic), SLIDING));
                         p.line(line("strain", e(|x| x.strain), EXACT));
                         p.line(line("friction", e(|x| x.friction_dissipated), FIXED));
+                        // Only scenes where blocks hit each other have this layer.
+                        let impacts = e(|x| x.impact_dissipated);
+                        if impacts.iter().any(|p| p[1] > 0.0) {
+                            p.line(line(
+                                "impacts",
+                                impacts,
+                                egui::Color32::from_rgb(200, 120, 40),
+                            ));
+                        }
                         p.line(line(
                             "numerical",
                             e(|x| x.residual()),
