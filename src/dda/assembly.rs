@@ -6,11 +6,13 @@
 //! springs), and a *nodal element* whose nodes are points carried by blocks
 //! (bolts, fixed points, connection elements).
 
-use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
+
+use nalgebra::DVector;
 
 use super::block::{Mat6, Vec6, t_matrix};
+use super::linear::{BlockMatrix, BlockPattern};
 use crate::model::geometry::Point;
-use crate::{Error, Result};
 
 /// Maps blocks to unknowns and holds the known increments of prescribed blocks.
 #[derive(Debug, Clone)]
@@ -43,8 +45,8 @@ impl DofMap {
 /// A linear system `K D = R` under assembly.
 #[derive(Debug, Clone)]
 pub struct System {
-    /// Effective stiffness.
-    pub k: DMatrix<f64>,
+    /// Effective stiffness (symmetric, block-sparse).
+    pub k: BlockMatrix,
     /// Right-hand side.
     pub r: DVector<f64>,
     /// Factor multiplying stiffness terms: 1 − αf (1 for the static solve).
@@ -52,22 +54,26 @@ pub struct System {
 }
 
 impl System {
-    /// An all-zero system of size n.
-    pub fn zeros(n: usize, stiffness_factor: f64) -> Self {
+    /// An all-zero system on a pattern.
+    pub fn zeros(pattern: Arc<BlockPattern>, stiffness_factor: f64) -> Self {
+        let n = pattern.unknowns();
         Self {
-            k: DMatrix::zeros(n, n),
+            k: BlockMatrix::zeros(pattern),
             r: DVector::zeros(n),
             stiffness_factor,
         }
     }
 
+    /// Copies another system of the same pattern without allocating.
+    pub fn copy_from(&mut self, other: &System) {
+        self.k.copy_from(&other.k);
+        self.r.copy_from(&other.r);
+        self.stiffness_factor = other.stiffness_factor;
+    }
+
     /// Adds `scale · m` to the diagonal block of the unknowns starting at `s`.
     pub fn add_diag_block(&mut self, s: usize, m: &Mat6, scale: f64) {
-        for i in 0..6 {
-            for j in 0..6 {
-                self.k[(s + i, s + j)] += scale * m[i][j];
-            }
-        }
+        self.k.add(s / 6, s / 6, m, scale);
     }
 
     /// Adds `v` to the right-hand side of the unknowns starting at `s`.
@@ -99,17 +105,7 @@ impl System {
             for qpart in parts.iter() {
                 let Some((bq, vq)) = *qpart else { continue };
                 match dofs.slot[bq] {
-                    Some(sq) => {
-                        for i in 0..6 {
-                            let ci = c * vp[i];
-                            if ci == 0.0 {
-                                continue;
-                            }
-                            for j in 0..6 {
-                                self.k[(sp + i, sq + j)] += ci * vq[j];
-                            }
-                        }
-                    }
+                    Some(sq) => self.k.add_outer(sp / 6, sq / 6, vp, vq, c),
                     None => {
                         // Known increment: the coupling goes to the right-hand side.
                         let q_known: f64 = (0..6).map(|j| vq[j] * known[bq][j]).sum();
@@ -135,20 +131,21 @@ impl System {
     ) {
         let n = nodes.len();
         let dim = 2 * n;
-        let ts: Vec<[[f64; 6]; 2]> = nodes
-            .iter()
-            .map(|&(b, x)| t_matrix(centroids[b], x))
-            .collect();
         let c = self.stiffness_factor;
-        for (k, &(bk, _)) in nodes.iter().enumerate() {
+        for (k, &(bk, xk)) in nodes.iter().enumerate() {
             let Some(sk) = dofs.slot[bk] else { continue };
-            let tk = &ts[k];
+            let tk = t_matrix(centroids[bk], xk);
             // Start-of-step force.
             for i in 0..6 {
                 self.r[sk + i] -= tk[0][i] * fe[2 * k] + tk[1][i] * fe[2 * k + 1];
             }
-            for (l, &(bl, _)) in nodes.iter().enumerate() {
-                let tl = &ts[l];
+            for (l, &(bl, xl)) in nodes.iter().enumerate() {
+                // Only the upper blocks are stored (the lower are their transposes).
+                let upper = dofs.slot[bl].is_some_and(|sl| sk <= sl);
+                if dofs.slot[bl].is_some() && !upper {
+                    continue;
+                }
+                let tl = t_matrix(centroids[bl], xl);
                 // 2×2 sub-block of ke between nodes k and l.
                 let sub = [
                     [ke[(2 * k) * dim + 2 * l], ke[(2 * k) * dim + 2 * l + 1]],
@@ -170,13 +167,7 @@ impl System {
                     }
                 }
                 match dofs.slot[bl] {
-                    Some(sl) => {
-                        for i in 0..6 {
-                            for j in 0..6 {
-                                self.k[(sk + i, sl + j)] += c * m[i][j];
-                            }
-                        }
-                    }
+                    Some(sl) => self.k.add(sk / 6, sl / 6, &m, c),
                     None => {
                         for i in 0..6 {
                             let s: f64 = (0..6).map(|j| m[i][j] * known[bl][j]).sum();
@@ -185,28 +176,6 @@ impl System {
                     }
                 }
             }
-        }
-    }
-
-    /// Solves the system (Cholesky: the effective stiffness is symmetric positive definite).
-    pub fn solve(self, time: f64) -> Result<DVector<f64>> {
-        let System { k, r, .. } = self;
-        if r.iter().any(|v| !v.is_finite()) || k.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Solver {
-                time,
-                reason: "the system contains a non-finite value (NaN/inf); check material \
-                         constants, penalties and the time step"
-                    .into(),
-            });
-        }
-        match k.cholesky() {
-            Some(ch) => Ok(ch.solve(&r)),
-            None => Err(Error::Solver {
-                time,
-                reason: "the system matrix is not positive definite: a block is unsupported \
-                         or a penalty/material constant is negative or far too large"
-                    .into(),
-            }),
         }
     }
 }

@@ -13,6 +13,7 @@ pub mod contact;
 pub mod energy;
 pub mod joints;
 pub mod judge;
+pub mod linear;
 pub mod params;
 pub mod solver;
 

@@ -1,11 +1,13 @@
 //! The DDA time step: assembly, the open-close iteration, Δt control and the commit.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use nalgebra::DVector;
 use serde::Serialize;
 
 use super::assembly::{DofMap, System};
+use super::linear::{BlockPattern, LinearSolver, SolveError};
 use super::block::{
     Block, BlockRole, Vec6, point_displacement, point_displacement_exact_rotation,
     t_transpose_times,
@@ -119,6 +121,12 @@ pub struct Dda {
     ground: usize,
     ground_kind: GroundKind,
     dofs: DofMap,
+    /// Which blocks can couple in the system matrix (fixed for the run).
+    pattern: Arc<BlockPattern>,
+    /// Cholesky solver keeping its symbolic analysis and last factor.
+    linear: LinearSolver,
+    /// The system of the current open-close pass (kept to reuse its storage).
+    pass_system: System,
     pairs: Vec<ContactPair>,
     contacts: Vec<Contact>,
     memory: HashMap<ContactKey, ContactMemory>,
@@ -309,11 +317,26 @@ impl Dda {
             .map(|b| b.role != BlockRole::PrescribedGround)
             .collect();
         let dofs = DofMap::new(&is_free);
+        let pattern = Arc::new(coupling_pattern(
+            &dofs,
+            &pairs,
+            &bolts,
+            &fixed,
+            &connections,
+        ));
+        let linear = LinearSolver::new(Arc::clone(&pattern)).map_err(|e| Error::Solver {
+            time: 0.0,
+            reason: format!("cannot analyse the system matrix: {e:?}"),
+        })?;
+        let pass_system = System::zeros(Arc::clone(&pattern), 1.0);
         let mut model = Self {
             blocks,
             ground,
             ground_kind: scene.ground.kind,
             dofs,
+            pattern,
+            linear,
+            pass_system,
             pairs,
             contacts: Vec::new(),
             memory: HashMap::new(),
@@ -497,18 +520,20 @@ impl Dda {
             Mode::Static { .. } => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
             Mode::Modal => (0.0, 1.0),
         };
-        let mut sys = System::zeros(self.dofs.n, stiffness_factor);
+        let mut sys = System::zeros(Arc::clone(&self.pattern), stiffness_factor);
         for (bi, b) in self.blocks.iter().enumerate() {
             let Some(s) = self.dofs.slot[bi] else {
                 continue;
             };
             sys.add_diag_block(s, &b.mass, mass_factor);
             // Elastic stiffness on the strain unknowns and the initial-stress force.
+            let diagonal = sys.k.diagonal_mut(s / 6);
             for i in 0..3 {
                 for j in 0..3 {
-                    sys.k[(s + 3 + i, s + 3 + j)] +=
-                        stiffness_factor * b.moments.area * b.elasticity[i][j];
+                    diagonal[3 + i][3 + j] += stiffness_factor * b.moments.area * b.elasticity[i][j];
                 }
+            }
+            for i in 0..3 {
                 sys.r[s + 3 + i] -= b.moments.area * b.stress[i];
             }
             // Gravity.
@@ -697,10 +722,20 @@ impl Dda {
         let open_tolerance = 1e-12 * self.structure_size;
         let slip_tolerance = 1e-12 * self.structure_size;
         let max_passes = self.params.max_open_close_passes;
+        let mut solution = vec![0.0; self.dofs.n];
         for pass in 1..=max_passes {
-            let mut sys = base.clone();
+            let mut sys = std::mem::replace(
+                &mut self.pass_system,
+                System::zeros(Arc::clone(&self.pattern), 1.0),
+            );
+            sys.copy_from(&base);
             self.add_contacts(&mut sys, known, mode);
-            let solution = sys.solve(self.time)?;
+            let structure = self.structure_key(mode);
+            let solved = self
+                .linear
+                .solve(&sys.k, sys.r.as_slice(), structure, &mut solution);
+            self.pass_system = sys;
+            solved.map_err(|e| self.solve_error(e))?;
             let increments = self.increments(&solution, known);
             let velocities = match mode {
                 Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
@@ -792,6 +827,60 @@ impl Dda {
         Ok(None)
     }
 
+    /// Identifies what makes the system matrix jump (rather than drift with the
+    /// geometry): the problem solved, the step size and scheme, and every contact's
+    /// state. The linear solver keeps its factor only while this stays the same.
+    fn structure_key(&self, mode: Mode) -> u64 {
+        const PRIME: u64 = 0x0000_0100_0000_01b3;
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut mix = |v: u64| h = (h ^ v).wrapping_mul(PRIME);
+        match mode {
+            Mode::Dynamic { dt } => {
+                mix(1);
+                mix(dt.to_bits());
+                mix(self.coeffs.beta.to_bits());
+                mix(self.coeffs.alpha_m.to_bits());
+                mix(self.coeffs.alpha_f.to_bits());
+                mix(self.params.contact_damping.to_bits());
+            }
+            Mode::Static { friction } => {
+                mix(2);
+                mix(friction.map_or(u64::MAX, f64::to_bits));
+            }
+            Mode::Modal => mix(3),
+        }
+        for c in &self.contacts {
+            mix(c.key.vertex_block as u64);
+            mix(c.key.vertex as u64);
+            mix(c.key.edge_block as u64);
+            mix(c.key.edge as u64);
+            mix(u64::from(c.state.code()));
+        }
+        h
+    }
+
+    /// A linear-solve failure as a solver error saying what to check.
+    fn solve_error(&self, e: SolveError) -> Error {
+        let reason = match e {
+            SolveError::NotPositiveDefinite => {
+                "the system matrix is not positive definite: a block is unsupported or a \
+                 penalty/material constant is negative or far too large"
+            }
+            SolveError::NonFinite => {
+                "the system contains a non-finite value (NaN/inf); check material constants, \
+                 penalties and the time step"
+            }
+            SolveError::OutsidePattern => {
+                "internal error: a joint or contact couples blocks the system pattern does \
+                 not hold"
+            }
+        };
+        Error::Solver {
+            time: self.time,
+            reason: reason.into(),
+        }
+    }
+
     /// Velocities at the end of a trial step (Newmark update; the prescribed ground's
     /// from the motion), used to judge slip reversals.
     fn end_velocities(&self, increments: &[Vec6], dt: f64) -> Vec<Vec6> {
@@ -823,7 +912,7 @@ impl Dda {
     }
 
     /// Increments of all blocks from the solution vector and the known ones.
-    fn increments(&self, solution: &DVector<f64>, known: &[Vec6]) -> Vec<Vec6> {
+    fn increments(&self, solution: &[f64], known: &[Vec6]) -> Vec<Vec6> {
         (0..self.blocks.len())
             .map(|b| match self.dofs.slot[b] {
                 Some(s) => {
@@ -1408,13 +1497,13 @@ impl Dda {
     pub fn modes(&self) -> Result<Modes> {
         let model = self.clone();
         let k = model.tangent_stiffness()?;
-        let mut mass = System::zeros(model.dofs.n, 1.0);
+        let mut mass = System::zeros(Arc::clone(&model.pattern), 1.0);
         for (bi, b) in model.blocks.iter().enumerate() {
             if let Some(s) = model.dofs.slot[bi] {
                 mass.add_diag_block(s, &b.mass, 1.0);
             }
         }
-        let modal = crate::linalg::modal(&mass.k, &k)?;
+        let modal = crate::linalg::modal(&mass.k.to_dense(), &k)?;
         let mut frequencies_hz = Vec::new();
         let mut shapes = Vec::new();
         for (col, &w) in modal.omega.iter().enumerate() {
@@ -1601,4 +1690,39 @@ fn yield_stretch(c: &Contact, state: ContactState, gap_end: f64) -> Option<f64> 
             Some(direction * f / c.props.shear_penalty)
         }
     }
+}
+
+/// The block couplings the system matrix can have: joints between their blocks, and each
+/// declared contact pair (the only blocks contacts are searched between).
+fn coupling_pattern(
+    dofs: &DofMap,
+    pairs: &[ContactPair],
+    bolts: &[Bolt],
+    fixed: &[FixedPoint],
+    connections: &[Connection],
+) -> BlockPattern {
+    let free = |b: usize| dofs.slot[b].map(|s| s / 6);
+    let mut couplings = Vec::new();
+    let mut tie = |blocks: &[usize]| {
+        for &a in blocks {
+            for &b in blocks {
+                if let (Some(i), Some(j)) = (free(a), free(b)) {
+                    couplings.push((i, j));
+                }
+            }
+        }
+    };
+    for p in pairs {
+        tie(&p.blocks);
+    }
+    for b in bolts {
+        tie(&b.blocks);
+    }
+    for f in fixed {
+        tie(&[f.block]);
+    }
+    for c in connections {
+        tie(&c.blocks);
+    }
+    BlockPattern::new(dofs.n / 6, couplings)
 }

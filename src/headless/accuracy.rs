@@ -40,9 +40,16 @@ pub struct AccuracyRow {
     pub rms_slip: f64,
     /// RMS error of the roof drift history / D.
     pub rms_drift: f64,
+    /// RMS error of the slip history / D against the Δt-converged DDA run of the same case
+    /// (self-convergence: what the time step alone costs); NaN where not computed.
+    pub rms_slip_self: f64,
     /// Relative error of the base acceleration peak.
     pub abase_error: f64,
 }
+
+/// Young's modulus of the two-block scene's (practically rigid) blocks, Pa: the penalty
+/// axis is also given relative to it.
+const BLOCK_E: f64 = 1e12;
 
 /// A two-block case of the study.
 #[derive(Debug, Clone, Copy)]
@@ -153,6 +160,7 @@ fn two_block_row(
     ground: Option<(GroundKind, f64)>,
     fixed_base: bool,
     reference: &TwoBlockRun,
+    converged: Option<&TwoBlockRun>,
 ) -> Result<AccuracyRow> {
     let req = RunRequest {
         alpha: case.alpha,
@@ -181,7 +189,6 @@ fn two_block_row(
         .first()
         .and_then(|c| c.normal_penalty)
         .unwrap_or(f64::NAN);
-    let record_every = ((2e-3 / dt).round() as usize).max(1);
     let params = SolverParams {
         dt,
         duration,
@@ -189,7 +196,7 @@ fn two_block_row(
         ..SolverParams::default()
     };
     let start = Instant::now();
-    let run = two_block::run_dda(&setup.scene, &setup.motion, params, record_every)?;
+    let run = two_block::run_dda(&setup.scene, &setup.motion, params, record_every(dt))?;
     let wall = start.elapsed().as_secs_f64();
     let a = setup.motion.peak_accel(duration);
     let big_omega = 2.0 * std::f64::consts::PI * case.ratio * setup.roles.structure_frequency_hz;
@@ -222,8 +229,38 @@ fn two_block_row(
         peak_error,
         rms_slip: rms(&run, reference, "slip_m") / d,
         rms_drift: rms(&run, reference, "roof_drift_m") / d,
+        rms_slip_self: converged.map_or(f64::NAN, |c| rms(&run, c, "slip_m") / d),
         abase_error: rel(m[2], mr[2]),
     })
+}
+
+/// Histories are compared every 0.5 ms: fine enough that interpolating them costs less
+/// than 1e-6 D.
+const SAMPLE_DT: f64 = 5e-4;
+
+fn record_every(dt: f64) -> usize {
+    ((SAMPLE_DT / dt).round() as usize).max(1)
+}
+
+/// The DDA run of a case at the finest time step (the default scheme), to measure what
+/// the time step alone costs: as Δt → 0 every scheme tends to it, and it differs from the
+/// exact mass-spring solution only by the model (penalty springs at the joint).
+fn converged_dda(case: &Case, duration: f64, dt: f64) -> Result<TwoBlockRun> {
+    let req = RunRequest {
+        alpha: case.alpha,
+        friction: case.friction,
+        freq_ratio: case.ratio,
+        duration: Some(duration),
+        dt,
+        ..RunRequest::default()
+    };
+    let setup = two_block_setup(&req)?;
+    let params = SolverParams {
+        dt,
+        duration,
+        ..SolverParams::default()
+    };
+    two_block::run_dda(&setup.scene, &setup.motion, params, record_every(dt))
 }
 
 fn exact_reference(case: &Case, duration: f64, fixed_base: bool) -> Result<TwoBlockRun> {
@@ -243,14 +280,14 @@ fn exact_reference(case: &Case, duration: f64, fixed_base: bool) -> Result<TwoBl
         setup.friction,
         &setup.motion,
         duration,
-        2e-3,
+        SAMPLE_DT,
     )
 }
 
 /// Runs the study; `tick(done, total)` reports progress.
 pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<AccuracyRow>> {
     let mut rows = Vec::new();
-    let duration = if quick { 4.0 } else { 20.0 };
+    let duration = if quick { 4.0 } else { 10.0 };
     let cases: Vec<Case> = if quick {
         CASES[..2].to_vec()
     } else {
@@ -273,7 +310,9 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
     let penalties: Vec<f64> = if quick {
         vec![1e9, 1e11]
     } else {
-        vec![1e9, 1e10, 1e11, 1e12, 1e13]
+        // 1e-3 to 1e4 × the blocks' E (1e12 Pa): from a soft joint to far stiffer than
+        // the blocks.
+        vec![1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e16]
     };
     let ratios: Vec<f64> = if quick {
         vec![1e2, 1e4]
@@ -292,34 +331,28 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
         done += 1;
         tick(done, total);
     };
-    // 1. Time step × integrator on the two-block cases.
+    // 1. Time step × integrator on the two-block cases, all over the same window, against
+    //    the exact solution and against the Δt-converged DDA run.
+    let finest = dts.iter().copied().fold(f64::INFINITY, f64::min);
     for case in &cases {
-        // Δt below 1e-4 only over a shorter window: the cost grows as 1/Δt.
         let reference = exact_reference(case, duration, false)?;
+        // A third of the finest step of the study, so that even its error is measurable.
+        let converged = converged_dda(case, duration, finest / 3.0)?;
         for &integ in &integrators {
             for &dt in &dts {
-                let d = if dt < 1e-4 {
-                    duration.min(4.0)
-                } else {
-                    duration
-                };
-                let reference_here = if d < duration {
-                    exact_reference(case, d, false)?
-                } else {
-                    reference.clone()
-                };
                 bump(
                     &mut rows,
                     two_block_row(
                         "timestep",
                         case,
-                        d,
+                        duration,
                         integ,
                         dt,
                         None,
                         None,
                         false,
-                        &reference_here,
+                        &reference,
+                        Some(&converged),
                     )?,
                 );
             }
@@ -342,6 +375,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
                     None,
                     true,
                     &fixed_ref,
+                    None,
                 )?,
             );
         }
@@ -361,6 +395,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
                 None,
                 false,
                 &reference,
+                None,
             )?,
         );
     }
@@ -377,6 +412,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
             None,
             false,
             &reference,
+            None,
         )?,
     );
     for &r in &ratios {
@@ -392,6 +428,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
                 Some((GroundKind::LargeMass, r)),
                 false,
                 &reference,
+                None,
             )?,
         );
     }
@@ -439,9 +476,12 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
                             ground: "prescribed".into(),
                             wall_time_s: r.wall_time_s,
                             steps: r.steps,
-                            peak_error: rel(r.peak_roof_accel_g, converged.peak_roof_accel_g),
+                            // Signed: whether the scheme's damping lowers the peak.
+                            peak_error: (r.peak_roof_accel_g - converged.peak_roof_accel_g)
+                                / converged.peak_roof_accel_g,
                             rms_slip: rel(r.max_slip_m.max(1e-9), converged.max_slip_m.max(1e-9)),
                             rms_drift: rel(r.peak_roof_drift_m, converged.peak_roof_drift_m),
+                            rms_slip_self: f64::NAN,
                             abase_error: rel(r.peak_roof_accel_g, mdof.peak_roof_accel_g),
                         },
                     );
@@ -594,52 +634,38 @@ fn report_markdown(rows: &[AccuracyRow]) -> String {
     let _ = writeln!(s, "# Error against run time\n");
     let _ = writeln!(
         s,
-        "All errors relative (peak metrics: |DDA − exact| / max(|exact|, 0.01) in the paper's normalisation; RMS errors of time histories / D). Wall times are for one run on one core.\n"
+        "All errors relative (peak metrics: |DDA − exact| / max(|exact|, 0.01) in the paper's \
+         normalisation; RMS errors of time histories / D). Wall times are for one run on one \
+         core. Generated by `slidebase accuracy`.\n"
     );
-    let _ = writeln!(
-        s,
-        "## Observed order of convergence (least squares of log error against log Δt)\n"
-    );
-    let _ = writeln!(
-        s,
-        "| integrator | fixed base (peak errors) | sliding, resonant case (RMS slip) | sliding, all cases (RMS slip, median order) |"
-    );
-    let _ = writeln!(s, "|---|---:|---:|---:|");
     let mut labels: Vec<String> = rows.iter().map(|r| r.integrator.clone()).collect();
     labels.sort();
     labels.dedup();
+    let _ = writeln!(s, "## Findings\n");
+    for line in findings(rows, &labels) {
+        let _ = writeln!(s, "- {line}");
+    }
+    let _ = writeln!(
+        s,
+        "\n## Observed order of convergence (least squares of log error against log Δt)\n"
+    );
+    let _ = writeln!(
+        s,
+        "Smooth phases: the fixed base, RMS roof-drift error against the closed form, over \
+         the step sizes where it lies between 1e-6 and 0.1 (the asymptotic range). Sliding: \
+         RMS slip error against the Δt-converged DDA run (self-convergence, so that the \
+         model's own difference from the exact solution does not mask the order), same \
+         range; all cases, median.\n"
+    );
+    let _ = writeln!(
+        s,
+        "| integrator | smooth (fixed base) | sliding, resonant case | sliding, all cases (median) |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|");
     for label in &labels {
-        let fixed: Vec<(f64, f64)> = rows
-            .iter()
-            .filter(|r| r.study == "fixed-base" && &r.integrator == label)
-            .map(|r| (r.dt, r.peak_error))
-            .collect();
-        let res: Vec<(f64, f64)> = rows
-            .iter()
-            .filter(|r| r.study == "timestep" && &r.integrator == label && r.case == CASES[0].name)
-            .map(|r| (r.dt, r.rms_slip))
-            .collect();
-        let mut orders: Vec<f64> = CASES
-            .iter()
-            .filter_map(|c| {
-                let pts: Vec<(f64, f64)> = rows
-                    .iter()
-                    .filter(|r| r.study == "timestep" && &r.integrator == label && r.case == c.name)
-                    .map(|r| (r.dt, r.rms_slip))
-                    .collect();
-                observed_order(&pts, 1e-7)
-            })
-            .collect();
-        orders.sort_by(f64::total_cmp);
-        let med = orders.get(orders.len() / 2).copied();
+        let (smooth, resonant, median) = orders(rows, label);
         let f = |o: Option<f64>| o.map_or("–".into(), |v| format!("{v:.2}"));
-        let _ = writeln!(
-            s,
-            "| {label} | {} | {} | {} |",
-            f(observed_order(&fixed, 1e-9)),
-            f(observed_order(&res, 1e-7)),
-            f(med)
-        );
+        let _ = writeln!(s, "| {label} | {} | {} | {} |", f(smooth), f(resonant), f(median));
     }
     let _ = writeln!(
         s,
@@ -647,29 +673,12 @@ fn report_markdown(rows: &[AccuracyRow]) -> String {
     );
     let _ = writeln!(
         s,
-        "| integrator | largest Δt with every case ≤ 1 % | mean wall time per 20 s run there |"
+        "| integrator | largest Δt with every case ≤ 1 % | mean wall time per run there |"
     );
     let _ = writeln!(s, "|---|---:|---:|");
     for label in &labels {
-        let mut dts: Vec<f64> = rows
-            .iter()
-            .filter(|r| r.study == "timestep" && &r.integrator == label)
-            .map(|r| r.dt)
-            .collect();
-        dts.sort_by(|a, b| b.total_cmp(a));
-        dts.dedup();
-        let ok = dts.iter().copied().find(|&dt| {
-            rows.iter()
-                .filter(|r| r.study == "timestep" && &r.integrator == label && r.dt == dt)
-                .all(|r| r.peak_error <= 0.01)
-        });
-        match ok {
-            Some(dt) => {
-                let sel: Vec<&AccuracyRow> = rows
-                    .iter()
-                    .filter(|r| r.study == "timestep" && &r.integrator == label && r.dt == dt)
-                    .collect();
-                let wall = sel.iter().map(|r| r.wall_time_s).sum::<f64>() / sel.len().max(1) as f64;
+        match cheapest_one_percent(rows, label) {
+            Some((dt, wall)) => {
                 let _ = writeln!(s, "| {label} | {dt:e} s | {wall:.3} s |");
             }
             None => {
@@ -681,7 +690,7 @@ fn report_markdown(rows: &[AccuracyRow]) -> String {
         (
             "penalty",
             "Penalty stiffness (resonant case, Δt = 1 ms, generalised-α)",
-            "normal penalty (N/m)",
+            "normal penalty, N/m (× the blocks' E)",
         ),
         (
             "ground",
@@ -697,7 +706,7 @@ fn report_markdown(rows: &[AccuracyRow]) -> String {
         let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|");
         for r in rows.iter().filter(|r| r.study == study) {
             let key = if study == "penalty" {
-                format!("{:.0e}", r.penalty)
+                format!("{:.0e} ({:.0e} × E)", r.penalty, r.penalty / BLOCK_E)
             } else {
                 r.ground.clone()
             };
@@ -735,4 +744,212 @@ fn report_markdown(rows: &[AccuracyRow]) -> String {
     }
     let _ = writeln!(s, "\n## Every run\n\nSee `work_precision.csv`.");
     s
+}
+
+/// Orders of one integrator: smooth (fixed base vs closed form), sliding resonant and the
+/// median over the sliding cases (self-convergence).
+fn orders(rows: &[AccuracyRow], label: &str) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let asymptotic = |pts: Vec<(f64, f64)>| -> Option<f64> {
+        let pts: Vec<(f64, f64)> = pts.into_iter().filter(|&(_, e)| e < 0.1).collect();
+        observed_order(&pts, 1e-6)
+    };
+    let smooth = asymptotic(
+        rows.iter()
+            .filter(|r| r.study == "fixed-base" && r.integrator == label)
+            .map(|r| (r.dt, r.rms_drift))
+            .collect(),
+    );
+    let case_order = |name: &str| {
+        asymptotic(
+            rows.iter()
+                .filter(|r| r.study == "timestep" && r.integrator == label && r.case == name)
+                .map(|r| (r.dt, r.rms_slip_self))
+                .collect(),
+        )
+    };
+    let resonant = case_order(CASES[0].name);
+    let mut all: Vec<f64> = CASES.iter().filter_map(|c| case_order(c.name)).collect();
+    all.sort_by(f64::total_cmp);
+    (smooth, resonant, all.get(all.len() / 2).copied())
+}
+
+/// The largest Δt at which every two-block case is within 1 % on the paper's metrics, and
+/// the mean wall time per run there.
+fn cheapest_one_percent(rows: &[AccuracyRow], label: &str) -> Option<(f64, f64)> {
+    let mut dts: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.study == "timestep" && r.integrator == label)
+        .map(|r| r.dt)
+        .collect();
+    dts.sort_by(|a, b| b.total_cmp(a));
+    dts.dedup();
+    let at = |dt: f64| {
+        rows.iter()
+            .filter(move |r| r.study == "timestep" && r.integrator == label && r.dt == dt)
+    };
+    let dt = dts
+        .into_iter()
+        .find(|&dt| at(dt).all(|r| r.peak_error <= 0.01))?;
+    let sel: Vec<&AccuracyRow> = at(dt).collect();
+    let wall = sel.iter().map(|r| r.wall_time_s).sum::<f64>() / sel.len().max(1) as f64;
+    Some((dt, wall))
+}
+
+/// The report's conclusions, computed from the rows.
+fn findings(rows: &[AccuracyRow], labels: &[String]) -> Vec<String> {
+    let mut out = Vec::new();
+    let order_text: Vec<String> = labels
+        .iter()
+        .map(|l| {
+            let (smooth, _, median) = orders(rows, l);
+            let f = |o: Option<f64>| o.map_or("–".into(), |v| format!("{v:.1}"));
+            format!("{l} {} (sliding {})", f(smooth), f(median))
+        })
+        .collect();
+    out.push(format!(
+        "Observed orders in smooth phases: {}. The classic DDA scheme is first order, the \
+         trapezoidal rule and the α-schemes second order; with stick-slip events the \
+         sliding runs converge more slowly (the events are located to O(Δt²) but the \
+         transitions are not smooth).",
+        order_text.join(", ")
+    ));
+    // The error floor of the model: converged DDA against the exact solution.
+    let finest = rows
+        .iter()
+        .filter(|r| r.study == "timestep")
+        .map(|r| r.dt)
+        .fold(f64::INFINITY, f64::min);
+    let floor: Vec<&AccuracyRow> = rows
+        .iter()
+        .filter(|r| r.study == "timestep" && r.dt == finest)
+        .collect();
+    if !floor.is_empty() {
+        let worst = floor.iter().map(|r| r.peak_error).fold(0.0, f64::max);
+        let worst_base = floor.iter().map(|r| r.abase_error).fold(0.0, f64::max);
+        let worst_slip = floor.iter().map(|r| r.rms_slip).fold(0.0, f64::max);
+        out.push(format!(
+            "Error floor of the penalty model: at Δt = {finest:e} s every scheme has converged \
+             to the DDA model's own solution, which differs from the exact mass-spring model \
+             by up to {:.1} % on the peak metrics (base acceleration {:.1} %: when the raft \
+             re-sticks, the joint's penalty springs ring at ~1 kHz, and a step that resolves \
+             them records the ringing) and {worst_slip:.1e} D in RMS slip. At Δt = 1 ms the \
+             generalised-α scheme (ρ∞ = 0) annihilates that ringing in one step, which is \
+             why it is closer to the exact model there than at smaller steps.",
+            100.0 * worst,
+            100.0 * worst_base
+        ));
+    }
+    let penalty: Vec<&AccuracyRow> = rows.iter().filter(|r| r.study == "penalty").collect();
+    if let (Some(soft), Some(stiff)) = (
+        penalty.iter().min_by(|a, b| a.penalty.total_cmp(&b.penalty)),
+        penalty.iter().max_by(|a, b| a.penalty.total_cmp(&b.penalty)),
+    ) {
+        let enough = penalty
+            .iter()
+            .filter(|r| r.peak_error <= 1.1 * stiff.peak_error)
+            .map(|r| r.penalty)
+            .fold(f64::INFINITY, f64::min);
+        out.push(format!(
+            "Penalty stiffness: a soft joint ({:.0e} N/m) costs {:.1} % on the peak metrics; \
+             from {enough:.0e} N/m ({:.0e} × E) on the error stays at the time-step floor \
+             ({:.2} %) up to {:.0e} N/m ({:.0e} × E), so a stiffer penalty costs no accuracy \
+             (the solver stays well conditioned) and the joint's elasticity sets no error \
+             above it.",
+            soft.penalty,
+            100.0 * soft.peak_error,
+            enough / BLOCK_E,
+            100.0 * stiff.peak_error,
+            stiff.penalty,
+            stiff.penalty / BLOCK_E
+        ));
+    }
+    let ground: Vec<&AccuracyRow> = rows
+        .iter()
+        .filter(|r| r.study == "ground" && r.ground.starts_with("large-mass"))
+        .collect();
+    if !ground.is_empty() {
+        let list: Vec<String> = ground
+            .iter()
+            .map(|r| {
+                format!(
+                    "{} {:.2} %",
+                    r.ground.trim_start_matches("large-mass:"),
+                    100.0 * r.peak_error
+                )
+            })
+            .collect();
+        let prescribed = rows
+            .iter()
+            .find(|r| r.study == "ground" && r.ground == "prescribed")
+            .map_or(f64::NAN, |r| r.peak_error);
+        out.push(format!(
+            "Large-mass ground (paper eq. 4), peak error by m_g/m_structure: {}; prescribed \
+             motion {:.2} %. A light ground is pushed back by the structure (error ∝ 1/ratio); \
+             a very heavy one loses the structure's motion to round-off (its increments are \
+             the ground's ± the relative motion, ∝ ratio·ε). Ratios of 1e3–1e6 are as good as \
+             prescribed motion, which is the default and exact.",
+            list.join(", "),
+            100.0 * prescribed
+        ));
+    }
+    let cheapest = labels
+        .iter()
+        .filter_map(|l| cheapest_one_percent(rows, l).map(|(dt, w)| (l, dt, w)))
+        .min_by(|a, b| a.2.total_cmp(&b.2));
+    match cheapest {
+        Some((label, dt, wall)) => {
+            let default = crate::dda::Integrator::default().label();
+            let note = if *label == default && (dt - 1e-3).abs() < 1e-12 {
+                "— the solver's default".to_string()
+            } else {
+                format!(
+                    "(the solver's default is {default} at Δt = 1 ms: it keeps a margin for \
+                     records and scenes with faster content than these harmonic cases)"
+                )
+            };
+            out.push(format!(
+                "Recommended setting: {label} at Δt = {dt:e} s, the cheapest that keeps every \
+                 two-block case within 1 % on all four paper metrics ({wall:.3} s per run \
+                 here) {note}."
+            ));
+        }
+        None => out.push(
+            "No setting of the study keeps every two-block case within 1 % on all four \
+             metrics."
+                .into(),
+        ),
+    }
+    let frame = |fixed: bool, label: &str| {
+        rows.iter()
+            .filter(|r| {
+                r.study == "three-storey"
+                    && r.integrator == label
+                    && r.case.starts_with(if fixed { "fixed" } else { "sliding" })
+            })
+            .min_by(|a, b| (a.dt - 1e-3).abs().total_cmp(&(b.dt - 1e-3).abs()))
+            .map(|r| r.peak_error)
+    };
+    if let (Some(sc), Some(fc), Some(sg), Some(fg)) = (
+        frame(false, "classic"),
+        frame(true, "classic"),
+        frame(false, "generalized-alpha:0"),
+        frame(true, "generalized-alpha:0"),
+    ) {
+        out.push(format!(
+            "Three-storey frame on El Centro at Δt = 1 ms: against a Δt = 0.1 ms run the peak \
+             roof acceleration is off by {:+.1} % (sliding) and {:+.1} % (fixed) with the \
+             classic scheme, {:+.1} % and {:+.1} % with generalised-α: the sliding/fixed \
+             ratio of peak roof accelerations moves by {:+.1} % (classic) and {:+.1} % \
+             (generalised-α) from its converged value. Numerical damping is not where the \
+             isolation comes from; the ratio is a property of the model (see the table \
+             below for the converged values).",
+            100.0 * sc,
+            100.0 * fc,
+            100.0 * sg,
+            100.0 * fg,
+            100.0 * ((1.0 + sc) / (1.0 + fc) - 1.0),
+            100.0 * ((1.0 + sg) / (1.0 + fg) - 1.0)
+        ));
+    }
+    out
 }
