@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use slidebase::dda::Integrator;
 use slidebase::headless::run::{RunRequest, run, write_outputs};
-use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, run_sweep};
+use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, parse_shard, run_sweep};
 use slidebase::headless::two_block::ModelKind;
 use slidebase::model::scene::GroundKind;
 
@@ -38,6 +38,10 @@ enum Command {
     Accuracy(AccuracyArgs),
     /// Stiff and extreme cases, each checked against a physical fact.
     Stability(StabilityArgs),
+    /// Benchmarks: the paper's runs, the Figs 4–9 sweep and a scaling series.
+    Bench(BenchArgs),
+    /// Join the sweep.csv files of sweep shards (`sweep --shard I/N`) into one sweep.
+    Merge(MergeArgs),
     /// List the built-in scenes and ground-motion records.
     List,
 }
@@ -233,6 +237,45 @@ struct SweepArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     jobs: Option<usize>,
+    /// Run only slice I of N of the grid (e.g. `--shard $SLURM_ARRAY_TASK_ID/16`); join
+    /// the slices' sweep.csv files with `slidebase merge`.
+    #[arg(long)]
+    shard: Option<String>,
+}
+
+#[derive(Debug, clap::Args)]
+struct BenchArgs {
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Fewer repeats, shorter windows, a smaller scaling series and sweep (about a minute).
+    #[arg(long)]
+    quick: bool,
+    /// Repeats of each timed run (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    repeat: usize,
+    /// Threads for the sweep (default: all cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Leave out the Figs 4–9 sweep.
+    #[arg(long)]
+    no_sweep: bool,
+    /// Leave out the scaling series.
+    #[arg(long)]
+    no_scaling: bool,
+    /// Also write bench.json, scaling.csv and scaling.png here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
+struct MergeArgs {
+    /// The shards' sweep.csv files.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Output folder for the joined sweep.csv, the figures and errors.md.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
 }
 
 /// Entry point of the binary.
@@ -246,6 +289,8 @@ pub fn main() -> Result<()> {
         Some(Command::Render(args)) => cmd_render(args),
         Some(Command::Accuracy(args)) => cmd_accuracy(args),
         Some(Command::Stability(args)) => cmd_stability(args),
+        Some(Command::Bench(args)) => cmd_bench(args),
+        Some(Command::Merge(args)) => cmd_merge(args),
         Some(Command::List) => cmd_list(),
         None => cmd_default(),
     }
@@ -344,6 +389,7 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
         dt: args.dt,
         integrator: Integrator::parse(&args.integrator)?,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
+        shard: args.shard.as_deref().map(parse_shard).transpose()?,
     };
     for &a in &req.alphas {
         if !(a > 0.0 && a < 1.0) {
@@ -369,26 +415,29 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
     let start = std::time::Instant::now();
     let (rows, failures) = pool.install(|| run_sweep(&req, &|| bar.inc(1)));
     bar.finish_and_clear();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let csv = args.out.join("sweep.csv");
-    slidebase::post::sweep::write_sweep_csv(&csv, &rows)?;
-    out(&format!(
-        "wrote {} ({} runs in {:.1} s)",
-        csv.display(),
-        rows.len(),
-        start.elapsed().as_secs_f64()
-    ))?;
-    for f in slidebase::post::sweep::plot_paper_figures(&rows, &args.out)? {
-        out(&format!("wrote {}", f.display()))?;
+    match req.shard {
+        Some((i, n)) => {
+            std::fs::create_dir_all(&args.out)
+                .with_context(|| format!("creating {}", args.out.display()))?;
+            let csv = args.out.join("sweep.csv");
+            slidebase::post::sweep::write_sweep_csv(&csv, &rows)?;
+            out(&format!(
+                "wrote {} (shard {i}/{n}: {} runs in {:.1} s); join the shards with \
+                 `slidebase merge --out DIR SHARD/sweep.csv…`",
+                csv.display(),
+                rows.len(),
+                start.elapsed().as_secs_f64()
+            ))?;
+        }
+        None => {
+            write_sweep_outputs(&rows, &args.out)?;
+            out(&format!(
+                "{} runs in {:.1} s",
+                rows.len(),
+                start.elapsed().as_secs_f64()
+            ))?;
+        }
     }
-    let table = slidebase::post::sweep::error_table(&rows, 0.01);
-    out(&format!(
-        "\nDDA against the exact mass-spring model (relative errors, floor 0.01):\n{table}"
-    ))?;
-    let report = args.out.join("errors.md");
-    std::fs::write(&report, table.to_string())
-        .with_context(|| format!("writing {}", report.display()))?;
     if !failures.is_empty() {
         for f in &failures {
             eprintln!(
@@ -401,6 +450,77 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
             );
         }
         bail!("{} of {} runs failed", failures.len(), total);
+    }
+    Ok(())
+}
+
+/// Writes sweep.csv, the paper's figures and errors.md for a finished sweep.
+fn write_sweep_outputs(rows: &[slidebase::post::sweep::SweepRow], dir: &PathBuf) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let csv = dir.join("sweep.csv");
+    slidebase::post::sweep::write_sweep_csv(&csv, rows)?;
+    out(&format!("wrote {} ({} runs)", csv.display(), rows.len()))?;
+    for f in slidebase::post::sweep::plot_paper_figures(rows, dir)? {
+        out(&format!("wrote {}", f.display()))?;
+    }
+    let table = slidebase::post::sweep::error_table(rows, 0.01);
+    out(&format!(
+        "\nDDA against the exact mass-spring model (relative errors, floor 0.01):\n{table}"
+    ))?;
+    let report = dir.join("errors.md");
+    std::fs::write(&report, table.to_string())
+        .with_context(|| format!("writing {}", report.display()))?;
+    Ok(())
+}
+
+fn cmd_merge(args: MergeArgs) -> Result<()> {
+    let mut rows = Vec::new();
+    for path in &args.inputs {
+        rows.extend(slidebase::post::sweep::read_sweep_csv(path)?);
+    }
+    // The same grid point from two shards means the shards overlap (or a file was given
+    // twice): say so rather than plot it twice.
+    let mut seen = std::collections::HashSet::new();
+    for r in &rows {
+        let key = (
+            r.model.clone(),
+            r.alpha.to_bits(),
+            r.friction.to_bits(),
+            r.freq_ratio.to_bits(),
+        );
+        if !seen.insert(key) {
+            bail!(
+                "invalid merge: {} α={} ρ={} Ω/ω={} appears in more than one input",
+                r.model,
+                r.alpha,
+                r.friction,
+                r.freq_ratio
+            );
+        }
+    }
+    write_sweep_outputs(&rows, &args.out)
+}
+
+fn cmd_bench(args: BenchArgs) -> Result<()> {
+    use slidebase::headless::bench::{BenchOptions, report_text, run_bench, write_bench};
+    let options = BenchOptions {
+        quick: args.quick,
+        repeats: args.repeat.max(1),
+        jobs: args.jobs.unwrap_or(0),
+        sweep: !args.no_sweep,
+        scaling: !args.no_scaling,
+    };
+    let progress = |what: &str| eprintln!("bench: {what}");
+    let report = run_bench(&options, &progress)?;
+    if args.json {
+        out(&serde_json::to_string(&report)?)?;
+    } else {
+        out(&report_text(&report))?;
+    }
+    if let Some(dir) = &args.out {
+        for f in write_bench(&report, dir)? {
+            eprintln!("wrote {}", f.display());
+        }
     }
     Ok(())
 }

@@ -25,6 +25,7 @@ fn sweep(
         dt: 1e-3,
         integrator: Integrator::default(),
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
+        shard: None,
     };
     let (rows, failures) = run_sweep(&req, &|| {});
     assert!(failures.is_empty(), "failed runs: {failures:?}");

@@ -11,6 +11,7 @@ use std::sync::Arc;
 use nalgebra::DVector;
 
 use super::block::{Mat6, Vec6, t_matrix};
+use super::joints::ElementTerms;
 use super::linear::{BlockMatrix, BlockPattern};
 use crate::model::geometry::Point;
 
@@ -62,6 +63,13 @@ impl System {
             r: DVector::zeros(n),
             stiffness_factor,
         }
+    }
+
+    /// Zeroes the matrix and right-hand side and sets the stiffness factor.
+    pub fn clear(&mut self, stiffness_factor: f64) {
+        self.k.clear();
+        self.r.fill(0.0);
+        self.stiffness_factor = stiffness_factor;
     }
 
     /// Copies another system of the same pattern without allocating.
@@ -125,27 +133,30 @@ impl System {
         dofs: &DofMap,
         known: &[Vec6],
         centroids: &[Point],
-        nodes: &[(usize, Point)],
-        ke: &[f64],
-        fe: &[f64],
+        element: &ElementTerms,
     ) {
+        let (nodes, ke, fe) = (element.nodes(), element.ke(), element.fe());
         let n = nodes.len();
         let dim = 2 * n;
         let c = self.stiffness_factor;
-        for (k, &(bk, xk)) in nodes.iter().enumerate() {
+        let mut ts = [[[0.0; 6]; 2]; 3];
+        for (t, &(b, x)) in ts.iter_mut().zip(nodes) {
+            *t = t_matrix(centroids[b], x);
+        }
+        for (k, &(bk, _)) in nodes.iter().enumerate() {
             let Some(sk) = dofs.slot[bk] else { continue };
-            let tk = t_matrix(centroids[bk], xk);
+            let tk = &ts[k];
             // Start-of-step force.
             for i in 0..6 {
                 self.r[sk + i] -= tk[0][i] * fe[2 * k] + tk[1][i] * fe[2 * k + 1];
             }
-            for (l, &(bl, xl)) in nodes.iter().enumerate() {
+            for (l, &(bl, _)) in nodes.iter().enumerate() {
                 // Only the upper blocks are stored (the lower are their transposes).
                 let upper = dofs.slot[bl].is_some_and(|sl| sk <= sl);
                 if dofs.slot[bl].is_some() && !upper {
                     continue;
                 }
-                let tl = t_matrix(centroids[bl], xl);
+                let tl = &ts[l];
                 // 2×2 sub-block of ke between nodes k and l.
                 let sub = [
                     [ke[(2 * k) * dim + 2 * l], ke[(2 * k) * dim + 2 * l + 1]],

@@ -85,6 +85,41 @@ pub fn mass_matrix(density: f64, m: &Moments) -> Mat6 {
     k
 }
 
+/// The frame of one polygon edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeFrame {
+    /// Unit tangent, from the edge's first vertex to its second.
+    pub tangent: Point,
+    /// Outward unit normal (to the right of the tangent, the polygon being
+    /// counter-clockwise).
+    pub normal: Point,
+    /// Length, m.
+    pub length: f64,
+}
+
+/// The edge frames of a counter-clockwise polygon.
+pub fn edge_frames(vertices: &[Point]) -> Vec<EdgeFrame> {
+    let mut edges = Vec::with_capacity(vertices.len());
+    update_edge_frames(vertices, &mut edges);
+    edges
+}
+
+/// Recomputes the edge frames of a polygon in place.
+fn update_edge_frames(vertices: &[Point], edges: &mut Vec<EdgeFrame>) {
+    let n = vertices.len();
+    edges.clear();
+    edges.extend((0..n).map(|k| {
+        let e = geometry::sub(vertices[(k + 1) % n], vertices[k]);
+        let length = e[0].hypot(e[1]);
+        let tangent = [e[0] / length, e[1] / length];
+        EdgeFrame {
+            tangent,
+            normal: [tangent[1], -tangent[0]],
+            length,
+        }
+    }));
+}
+
 /// What drives a block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BlockRole {
@@ -121,6 +156,9 @@ pub struct Block {
     pub mass: Mat6,
     /// Free, prescribed ground or large-mass ground.
     pub role: BlockRole,
+    /// Unit tangent, outward normal and length of each edge (edge k runs from vertex k
+    /// to vertex k + 1), kept with the vertices for the contact search.
+    pub edges: Vec<EdgeFrame>,
     /// Centroid at the reference time (after initial equilibrium), m.
     pub reference_centroid: Point,
     /// Accumulated rotation r0 since the reference time, rad.
@@ -137,6 +175,7 @@ impl Block {
     ) -> Result<Self> {
         let moments = geometry::moments(&vertices, name)?;
         Ok(Self {
+            edges: edge_frames(&vertices),
             name: name.to_string(),
             mass: mass_matrix(material.density, &moments),
             reference_centroid: moments.centroid,
@@ -191,12 +230,18 @@ impl Block {
     /// mass matrix are updated; velocity and acceleration are set by the integrator.
     pub fn apply_increment(&mut self, d: &Vec6, exact_rotation: bool) -> Result<()> {
         let c = self.moments.centroid;
+        // The rotation's sine and cosine once for all vertices.
+        let (sin, cos) = if exact_rotation {
+            d[2].sin_cos()
+        } else {
+            (d[2], 1.0)
+        };
         for p in self.vertices.iter_mut() {
-            let u = if exact_rotation {
-                point_displacement_exact_rotation(c, *p, d)
-            } else {
-                point_displacement(c, *p, d)
-            };
+            let (x, y) = (p[0] - c[0], p[1] - c[1]);
+            let u = [
+                d[0] + (cos - 1.0) * x - sin * y + x * d[3] + y * d[5] / 2.0,
+                d[1] + sin * x + (cos - 1.0) * y + y * d[4] + x * d[5] / 2.0,
+            ];
             p[0] += u[0];
             p[1] += u[1];
         }
@@ -208,6 +253,7 @@ impl Block {
             }
         }
         self.rotation += d[2];
+        update_edge_frames(&self.vertices, &mut self.edges);
         self.moments = geometry::moments(&self.vertices, &self.name)?;
         self.mass = mass_matrix(self.material.density, &self.moments);
         Ok(())

@@ -14,29 +14,58 @@ pub trait NodeMotion {
     fn node_displacement(&self, b: usize, x: Point) -> Point;
 }
 
-/// Stiffness, start force and energy of a nodal element for one step.
-#[derive(Debug, Clone, Default)]
+/// Stiffness and start force of a nodal element (up to three nodes) for one step, in
+/// fixed-size storage: elements are rebuilt every step, and allocating them would cost
+/// more than computing them.
+#[derive(Debug, Clone, Copy)]
 pub struct ElementTerms {
-    /// Nodes: (block, current position).
-    pub nodes: Vec<(usize, Point)>,
-    /// Stiffness on node displacements, 2n × 2n row-major.
-    pub ke: Vec<f64>,
+    count: usize,
+    nodes: [(usize, Point); 3],
+    /// Stiffness on node displacements, 2n × 2n row-major in the first (2n)² entries.
+    ke: [f64; 36],
     /// Node forces at the step start (∂E/∂u), 2n.
-    pub fe: Vec<f64>,
+    fe: [f64; 6],
 }
 
 impl ElementTerms {
-    /// Node forces at the end of the step: fe + ke·u.
-    pub fn end_forces(&self, u: &[Point]) -> Vec<f64> {
-        let dim = self.fe.len();
-        (0..dim)
-            .map(|i| {
-                self.fe[i]
-                    + (0..dim)
-                        .map(|j| self.ke[i * dim + j] * u[j / 2][j % 2])
-                        .sum::<f64>()
-            })
-            .collect()
+    /// Terms with these nodes (1 to 3) and zero stiffness and force.
+    fn with_nodes(nodes: &[(usize, Point)]) -> Self {
+        let mut all = [(0, [0.0; 2]); 3];
+        all[..nodes.len()].copy_from_slice(nodes);
+        Self {
+            count: nodes.len(),
+            nodes: all,
+            ke: [0.0; 36],
+            fe: [0.0; 6],
+        }
+    }
+
+    /// Nodes: (block, current position).
+    pub fn nodes(&self) -> &[(usize, Point)] {
+        &self.nodes[..self.count]
+    }
+
+    /// Stiffness on node displacements, 2n × 2n row-major.
+    pub fn ke(&self) -> &[f64] {
+        &self.ke[..4 * self.count * self.count]
+    }
+
+    /// Node forces at the step start (∂E/∂u), 2n.
+    pub fn fe(&self) -> &[f64] {
+        &self.fe[..2 * self.count]
+    }
+
+    /// Node forces at the end of the step: fe + ke·u (the first 2n entries).
+    pub fn end_forces(&self, u: &[Point]) -> [f64; 6] {
+        let dim = 2 * self.count;
+        let mut out = [0.0; 6];
+        for i in 0..dim {
+            out[i] = self.fe[i]
+                + (0..dim)
+                    .map(|j| self.ke[i * dim + j] * u[j / 2][j % 2])
+                    .sum::<f64>();
+        }
+        out
     }
 }
 
@@ -84,9 +113,12 @@ impl Bolt {
     /// Element terms for this step.
     pub fn terms(&self) -> ElementTerms {
         let k = self.stiffness;
+        let mut terms = ElementTerms::with_nodes(&[
+            (self.blocks[0], self.points[0]),
+            (self.blocks[1], self.points[1]),
+        ]);
         // Stiffness pattern [[S, −S], [−S, S]] for a 2×2 S.
-        let pattern = |s: [[f64; 2]; 2]| {
-            let mut ke = vec![0.0; 16];
+        let pattern = |ke: &mut [f64; 36], s: [[f64; 2]; 2]| {
             for (a, sa) in [(0usize, 1.0), (1usize, -1.0)] {
                 for (b, sb) in [(0usize, 1.0), (1usize, -1.0)] {
                     for i in 0..2 {
@@ -96,14 +128,13 @@ impl Bolt {
                     }
                 }
             }
-            ke
         };
         // fe = ∂E/∂u, ordered (P, Q): the bolt pulls Q with `f` and P with −f, and
         // ∂E/∂u is minus the force the bolt exerts on the node.
         let f = self.force_on_q();
-        let fe = vec![f[0], f[1], -f[0], -f[1]];
-        let ke = match self.kind {
-            BoltKind::TwoComponent => pattern([[k, 0.0], [0.0, k]]),
+        terms.fe[..4].copy_from_slice(&[f[0], f[1], -f[0], -f[1]]);
+        let s = match self.kind {
+            BoltKind::TwoComponent => [[k, 0.0], [0.0, k]],
             BoltKind::Axial => {
                 let d = sub(self.points[1], self.points[0]);
                 let l = d[0].hypot(d[1]).max(f64::MIN_POSITIVE);
@@ -119,17 +150,11 @@ impl Bolt {
                         s[i][j] = k * u[i] * u[j] + g * (id - u[i] * u[j]);
                     }
                 }
-                pattern(s)
+                s
             }
         };
-        ElementTerms {
-            nodes: vec![
-                (self.blocks[0], self.points[0]),
-                (self.blocks[1], self.points[1]),
-            ],
-            ke,
-            fe,
-        }
+        pattern(&mut terms.ke, s);
+        terms
     }
 
     /// Stored energy, J.
@@ -185,21 +210,18 @@ impl FixedPoint {
     pub fn terms(&self) -> ElementTerms {
         let p = self.projector();
         let c = sub(self.point, self.anchor);
-        let ke = vec![
+        let mut terms = ElementTerms::with_nodes(&[(self.block, self.point)]);
+        terms.ke[..4].copy_from_slice(&[
             self.penalty * p[0][0],
             self.penalty * p[0][1],
             self.penalty * p[1][0],
             self.penalty * p[1][1],
-        ];
-        let fe = vec![
+        ]);
+        terms.fe[..2].copy_from_slice(&[
             self.penalty * (p[0][0] * c[0] + p[0][1] * c[1]),
             self.penalty * (p[1][0] * c[0] + p[1][1] * c[1]),
-        ];
-        ElementTerms {
-            nodes: vec![(self.block, self.point)],
-            ke,
-            fe,
-        }
+        ]);
+        terms
     }
 
     /// Stored energy, J.
@@ -263,19 +285,18 @@ impl Connection {
                 cb[i][j] = (0..3).map(|k| c[i][k] * b[k][j]).sum();
             }
         }
-        let mut ke = vec![0.0; 36];
-        let mut fe = vec![0.0; 6];
+        let mut terms = ElementTerms::with_nodes(&[
+            (self.blocks[0], self.nodes[0]),
+            (self.blocks[1], self.nodes[1]),
+            (self.blocks[2], self.nodes[2]),
+        ]);
         for i in 0..6 {
-            fe[i] = area * (0..3).map(|k| b[k][i] * self.stress[k]).sum::<f64>();
+            terms.fe[i] = area * (0..3).map(|k| b[k][i] * self.stress[k]).sum::<f64>();
             for j in 0..6 {
-                ke[i * 6 + j] = area * (0..3).map(|k| b[k][i] * cb[k][j]).sum::<f64>();
+                terms.ke[i * 6 + j] = area * (0..3).map(|k| b[k][i] * cb[k][j]).sum::<f64>();
             }
         }
-        ElementTerms {
-            nodes: (0..3).map(|k| (self.blocks[k], self.nodes[k])).collect(),
-            ke,
-            fe,
-        }
+        terms
     }
 
     /// Strain energy ½ A εᵀ C ε, J.
@@ -295,9 +316,8 @@ impl Connection {
     /// Accumulates strain and stress from this step's node displacements and moves the nodes.
     pub fn commit(&mut self, motion: &impl NodeMotion) {
         let (_, b) = self.b_matrix();
-        let u: Vec<Point> = (0..3)
-            .map(|k| motion.node_displacement(self.blocks[k], self.nodes[k]))
-            .collect();
+        let u: [Point; 3] =
+            std::array::from_fn(|k| motion.node_displacement(self.blocks[k], self.nodes[k]));
         let flat: Vec6 = [u[0][0], u[0][1], u[1][0], u[1][1], u[2][0], u[2][1]];
         let mut de = [0.0; 3];
         for i in 0..3 {

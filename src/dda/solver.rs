@@ -1,21 +1,22 @@
 //! The DDA time step: assembly, the open-close iteration, Δt control and the commit.
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use nalgebra::DVector;
 use serde::Serialize;
 
 use super::assembly::{DofMap, System};
-use super::linear::{BlockPattern, LinearSolver, SolveError};
 use super::block::{
     Block, BlockRole, Vec6, point_displacement, point_displacement_exact_rotation,
     t_transpose_times,
 };
-use super::contact::{self, Contact, ContactKey, ContactMemory, ContactPair, JointProps, dot6};
+use super::contact::{
+    self, Contact, ContactMemories, ContactMemory, ContactPair, JointProps, dot6,
+};
 use super::energy::EnergyTerms;
 use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
 use super::judge::{ContactState, JudgeInput, judge};
+use super::linear::{BlockPattern, LinearSolver, SolveError};
 use super::params::{AlphaCoefficients, SolverParams};
 use crate::ground_motion::GroundMotion;
 use crate::model::geometry::{self, Point};
@@ -80,6 +81,13 @@ pub struct RunCounters {
     pub max_penetration_ratio: f64,
     /// Largest |energy residual| relative to the energy scale seen so far.
     pub max_energy_residual_rel: f64,
+    /// Linear systems solved (one per open-close pass).
+    pub linear_solves: u64,
+    /// Numeric factorisations of the system matrix (the rest were solved by conjugate
+    /// gradients preconditioned with a kept factor).
+    pub factorizations: u64,
+    /// Conjugate-gradient iterations with a kept factor.
+    pub cg_iterations: u64,
 }
 
 /// Which linear problem an iteration solves.
@@ -126,10 +134,14 @@ pub struct Dda {
     /// Cholesky solver keeping its symbolic analysis and last factor.
     linear: LinearSolver,
     /// The system of the current open-close pass (kept to reuse its storage).
-    pass_system: System,
+    pass_system: Option<System>,
+    /// The step's system without contacts (kept to reuse its storage).
+    base_system: Option<System>,
+    /// The step's joint terms (kept to reuse their storage).
+    elements: Vec<ElementTerms>,
     pairs: Vec<ContactPair>,
     contacts: Vec<Contact>,
-    memory: HashMap<ContactKey, ContactMemory>,
+    memory: ContactMemories,
     bolts: Vec<Bolt>,
     fixed: Vec<FixedPoint>,
     connections: Vec<Connection>,
@@ -149,6 +161,8 @@ pub struct Dda {
     last: StepReport,
     /// How the next step restarts the integrator after a contact event (if at all).
     restart: Restart,
+    /// When the last step was landed on an event.
+    last_landing: f64,
 }
 
 /// How a step restarts the time integrator after a contact event.
@@ -328,7 +342,7 @@ impl Dda {
             time: 0.0,
             reason: format!("cannot analyse the system matrix: {e:?}"),
         })?;
-        let pass_system = System::zeros(Arc::clone(&pattern), 1.0);
+        let pass_system = Some(System::zeros(Arc::clone(&pattern), 1.0));
         let mut model = Self {
             blocks,
             ground,
@@ -337,9 +351,11 @@ impl Dda {
             pattern,
             linear,
             pass_system,
+            base_system: None,
+            elements: Vec::new(),
             pairs,
             contacts: Vec::new(),
-            memory: HashMap::new(),
+            memory: ContactMemories::default(),
             bolts,
             fixed,
             connections,
@@ -358,6 +374,7 @@ impl Dda {
             counters: RunCounters::default(),
             last: StepReport::default(),
             restart: Restart::None,
+            last_landing: f64::NEG_INFINITY,
         };
         model.check_initial_overlap()?;
         if model.params.initial_equilibrium {
@@ -440,9 +457,20 @@ impl Dda {
         self.energy
     }
 
+    /// Number of unknowns of the system (6 per free block).
+    pub fn unknowns(&self) -> usize {
+        self.dofs.n
+    }
+
     /// Run totals.
     pub fn counters(&self) -> RunCounters {
-        self.counters
+        let linear = self.linear.stats();
+        RunCounters {
+            linear_solves: linear.solves,
+            factorizations: linear.factorizations,
+            cg_iterations: linear.iterations,
+            ..self.counters
+        }
     }
 
     /// The last step's report.
@@ -502,16 +530,35 @@ impl Dda {
     }
 
     fn element_terms(&self) -> Vec<ElementTerms> {
-        let mut out =
-            Vec::with_capacity(self.bolts.len() + self.fixed.len() + self.connections.len());
-        out.extend(self.bolts.iter().map(Bolt::terms));
-        out.extend(self.fixed.iter().map(FixedPoint::terms));
-        out.extend(self.connections.iter().map(Connection::terms));
+        let mut out = Vec::new();
+        self.element_terms_into(&mut out);
         out
     }
 
-    /// Assembles everything that does not depend on contact states.
+    /// This step's terms of every joint, into `out` (cleared first).
+    fn element_terms_into(&self, out: &mut Vec<ElementTerms>) {
+        out.clear();
+        out.extend(self.bolts.iter().map(Bolt::terms));
+        out.extend(self.fixed.iter().map(FixedPoint::terms));
+        out.extend(self.connections.iter().map(Connection::terms));
+    }
+
+    /// Assembles everything that does not depend on contact states (into a new system).
     fn assemble_base(&self, mode: Mode, known: &[Vec6], elements: &[ElementTerms]) -> System {
+        let mut sys = System::zeros(Arc::clone(&self.pattern), 1.0);
+        self.assemble_base_into(&mut sys, mode, known, elements);
+        sys
+    }
+
+    /// Assembles everything that does not depend on contact states into `sys` (same
+    /// pattern; its values are overwritten).
+    fn assemble_base_into(
+        &self,
+        sys: &mut System,
+        mode: Mode,
+        known: &[Vec6],
+        elements: &[ElementTerms],
+    ) {
         let c = &self.coeffs;
         let (mass_factor, stiffness_factor) = match mode {
             Mode::Dynamic { dt } => ((1.0 - c.alpha_m) / (c.beta * dt * dt), 1.0 - c.alpha_f),
@@ -520,7 +567,7 @@ impl Dda {
             Mode::Static { .. } => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
             Mode::Modal => (0.0, 1.0),
         };
-        let mut sys = System::zeros(Arc::clone(&self.pattern), stiffness_factor);
+        sys.clear(stiffness_factor);
         for (bi, b) in self.blocks.iter().enumerate() {
             let Some(s) = self.dofs.slot[bi] else {
                 continue;
@@ -530,7 +577,8 @@ impl Dda {
             let diagonal = sys.k.diagonal_mut(s / 6);
             for i in 0..3 {
                 for j in 0..3 {
-                    diagonal[3 + i][3 + j] += stiffness_factor * b.moments.area * b.elasticity[i][j];
+                    diagonal[3 + i][3 + j] +=
+                        stiffness_factor * b.moments.area * b.elasticity[i][j];
                 }
             }
             for i in 0..3 {
@@ -560,7 +608,7 @@ impl Dda {
         }
         let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
         for e in elements {
-            sys.add_nodal_element(&self.dofs, known, &centroids, &e.nodes, &e.ke, &e.fe);
+            sys.add_nodal_element(&self.dofs, known, &centroids, e);
         }
         for l in &self.loads {
             if let Some(s) = self.dofs.slot[l.block] {
@@ -568,7 +616,6 @@ impl Dda {
                 sys.add_rhs(s, &f, 1.0);
             }
         }
-        sys
     }
 
     /// Adds the contact terms of the current trial states.
@@ -707,8 +754,26 @@ impl Dda {
     /// Runs the open-close iteration. Returns the increments of all blocks and the number
     /// of passes, or `None` if the states did not settle within the allowed passes.
     fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Option<(Vec<Vec6>, usize)>> {
-        let elements = self.element_terms();
-        let base = self.assemble_base(mode, known, &elements);
+        let mut elements = std::mem::take(&mut self.elements);
+        self.element_terms_into(&mut elements);
+        let mut base = self
+            .base_system
+            .take()
+            .unwrap_or_else(|| System::zeros(Arc::clone(&self.pattern), 1.0));
+        self.assemble_base_into(&mut base, mode, known, &elements);
+        self.elements = elements;
+        let result = self.open_close(mode, known, &base);
+        self.base_system = Some(base);
+        result
+    }
+
+    /// The open-close passes of one step on its base system.
+    fn open_close(
+        &mut self,
+        mode: Mode,
+        known: &[Vec6],
+        base: &System,
+    ) -> Result<Option<(Vec<Vec6>, usize)>> {
         let alpha_f = match mode {
             Mode::Dynamic { .. } => self.coeffs.alpha_f,
             Mode::Static { .. } | Mode::Modal => 0.0,
@@ -724,17 +789,19 @@ impl Dda {
         let max_passes = self.params.max_open_close_passes;
         let mut solution = vec![0.0; self.dofs.n];
         for pass in 1..=max_passes {
-            let mut sys = std::mem::replace(
-                &mut self.pass_system,
-                System::zeros(Arc::clone(&self.pattern), 1.0),
-            );
-            sys.copy_from(&base);
+            let mut sys = match self.pass_system.take() {
+                Some(mut sys) => {
+                    sys.copy_from(base);
+                    sys
+                }
+                None => base.clone(),
+            };
             self.add_contacts(&mut sys, known, mode);
             let structure = self.structure_key(mode);
             let solved = self
                 .linear
                 .solve(&sys.k, sys.r.as_slice(), structure, &mut solution);
-            self.pass_system = sys;
+            self.pass_system = Some(sys);
             solved.map_err(|e| self.solve_error(e))?;
             let increments = self.increments(&solution, known);
             let velocities = match mode {
@@ -827,9 +894,10 @@ impl Dda {
         Ok(None)
     }
 
-    /// Identifies what makes the system matrix jump (rather than drift with the
-    /// geometry): the problem solved, the step size and scheme, and every contact's
-    /// state. The linear solver keeps its factor only while this stays the same.
+    /// Identifies what changes the whole system matrix (rather than its drift with the
+    /// geometry, or the low-rank change of contacts changing state): the problem solved,
+    /// the step size and the scheme. The linear solver tries its kept factor only while
+    /// this stays the same.
     fn structure_key(&self, mode: Mode) -> u64 {
         const PRIME: u64 = 0x0000_0100_0000_01b3;
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -848,13 +916,6 @@ impl Dda {
                 mix(friction.map_or(u64::MAX, f64::to_bits));
             }
             Mode::Modal => mix(3),
-        }
-        for c in &self.contacts {
-            mix(c.key.vertex_block as u64);
-            mix(c.key.vertex as u64);
-            mix(c.key.edge_block as u64);
-            mix(c.key.edge as u64);
-            mix(u64::from(c.state.code()));
         }
         h
     }
@@ -917,9 +978,7 @@ impl Dda {
             .map(|b| match self.dofs.slot[b] {
                 Some(s) => {
                     let mut d = [0.0; 6];
-                    for k in 0..6 {
-                        d[k] = solution[s + k];
-                    }
+                    d.copy_from_slice(&solution[s..s + 6]);
                     d
                 }
                 None => known[b],
@@ -1084,14 +1143,15 @@ impl Dda {
                 e += c.energy();
             }
         }
-        for (key, m) in &self.memory {
+        // The memory holds exactly the contacts of the last step.
+        for c in &self.contacts {
+            let Some(m) = self.memory.get(&c.key) else {
+                continue;
+            };
             if !m.state.is_closed() {
                 continue;
             }
-            let Some(pair) = self.contacts.iter().find(|c| c.key == *key) else {
-                continue;
-            };
-            let p = pair.props;
+            let p = c.props;
             e += 0.5 * m.normal_force * m.normal_force / p.normal_penalty;
             e += 0.5 * p.shear_penalty * m.shear * m.shear;
         }
@@ -1172,7 +1232,16 @@ impl Dda {
             // and must not creep up on it) but still lands on a further impact: a contact
             // that closes inside a backward-Euler step would leave it with the velocity
             // that closes the gap, which the next step would turn into a bounce.
-            if outcome.is_some() && self.params.locate_events && dt_override.is_none() {
+            // At most one landing per nominal step: with many contacts some contact has
+            // an event in nearly every step (blocks that touch at zero force chatter
+            // between stuck, sliding and open), and landing on each would cut the steps to
+            // nothing; the events between landings are taken at the step ends.
+            let may_land = self.time - self.last_landing >= self.params.dt * (1.0 - 1e-9);
+            if outcome.is_some()
+                && self.params.locate_events
+                && dt_override.is_none()
+                && (may_land || restart != Restart::None)
+            {
                 let (theta, impact) = self
                     .contacts
                     .iter()
@@ -1196,6 +1265,7 @@ impl Dda {
                 // (In a restart step, an impact at its very start is part of this step.)
                 if !at_start && theta < 0.999 {
                     dt_override = Some(theta * dt);
+                    self.last_landing = self.time + theta * dt;
                     continue;
                 }
                 if !at_start && theta < 1.0 {
@@ -1388,16 +1458,17 @@ impl Dda {
             .collect();
         for e in &ground_elements {
             let u: Vec<Point> = e
-                .nodes
+                .nodes()
                 .iter()
                 .map(|&(b, x)| point_displacement(centroids[b], x, &increments[b]))
                 .collect();
             let end = e.end_forces(&u);
-            for (k, &(b, _)) in e.nodes.iter().enumerate() {
+            let fe = e.fe();
+            for (k, &(b, _)) in e.nodes().iter().enumerate() {
                 if b == g {
                     input += 0.5
-                        * ((e.fe[2 * k] + end[2 * k]) * u[k][0]
-                            + (e.fe[2 * k + 1] + end[2 * k + 1]) * u[k][1]);
+                        * ((fe[2 * k] + end[2 * k]) * u[k][0]
+                            + (fe[2 * k + 1] + end[2 * k + 1]) * u[k][1]);
                 }
             }
         }

@@ -665,7 +665,13 @@ fn report_markdown(rows: &[AccuracyRow]) -> String {
     for label in &labels {
         let (smooth, resonant, median) = orders(rows, label);
         let f = |o: Option<f64>| o.map_or("–".into(), |v| format!("{v:.2}"));
-        let _ = writeln!(s, "| {label} | {} | {} | {} |", f(smooth), f(resonant), f(median));
+        let _ = writeln!(
+            s,
+            "| {label} | {} | {} | {} |",
+            f(smooth),
+            f(resonant),
+            f(median)
+        );
     }
     let _ = writeln!(
         s,
@@ -841,8 +847,12 @@ fn findings(rows: &[AccuracyRow], labels: &[String]) -> Vec<String> {
     }
     let penalty: Vec<&AccuracyRow> = rows.iter().filter(|r| r.study == "penalty").collect();
     if let (Some(soft), Some(stiff)) = (
-        penalty.iter().min_by(|a, b| a.penalty.total_cmp(&b.penalty)),
-        penalty.iter().max_by(|a, b| a.penalty.total_cmp(&b.penalty)),
+        penalty
+            .iter()
+            .min_by(|a, b| a.penalty.total_cmp(&b.penalty)),
+        penalty
+            .iter()
+            .max_by(|a, b| a.penalty.total_cmp(&b.penalty)),
     ) {
         let enough = penalty
             .iter()

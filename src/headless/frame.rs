@@ -160,6 +160,9 @@ pub struct FrameSummary {
     pub open_close_passes: u64,
     /// Δt cuts (DDA).
     pub dt_cuts: u64,
+    /// Numeric factorisations of the system matrix (DDA; the other passes were solved
+    /// with a kept factor).
+    pub factorizations: u64,
     /// Largest penetration / structure size (DDA).
     pub max_penetration_ratio: f64,
     /// Energy residual relative to the energy through the structure.
@@ -276,6 +279,7 @@ pub fn run_frame(req: &FrameRequest) -> Result<FrameOutcome> {
         summary: FrameSummary {
             open_close_passes: counters.passes,
             dt_cuts: counters.cuts,
+            factorizations: counters.factorizations,
             max_penetration_ratio: counters.max_penetration_ratio,
             energy_residual_rel: dda.energy_residual_relative(),
             ..summary
@@ -331,6 +335,7 @@ fn summarise(
         steps,
         open_close_passes: 0,
         dt_cuts: 0,
+        factorizations: 0,
         max_penetration_ratio: 0.0,
         energy_residual_rel: 0.0,
         wall_time_s: start.elapsed().as_secs_f64(),

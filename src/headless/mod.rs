@@ -4,6 +4,7 @@
 //! and never print (printing is the binary's job), so tests and other front ends can use them.
 
 pub mod accuracy;
+pub mod bench;
 pub mod frame;
 pub mod report;
 pub mod run;

@@ -27,6 +27,9 @@ pub struct SweepRequest {
     pub integrator: Integrator,
     /// Which models to run at every point.
     pub models: Vec<ModelKind>,
+    /// Run only slice I of N (1-based): the grid's jobs I, I + N, I + 2N… so that a job
+    /// array can share a sweep out and `slidebase merge` can join the pieces.
+    pub shard: Option<(usize, usize)>,
 }
 
 /// One grid point that failed, with the reason.
@@ -94,8 +97,28 @@ pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
         .collect())
 }
 
+/// Parses `I/N` (1 ≤ I ≤ N) for `--shard`.
+pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
+    let bad = || {
+        Error::invalid(
+            "--shard",
+            format!("expected I/N with 1 <= I <= N (e.g. 3/8), got '{text}'"),
+        )
+    };
+    let (i, n) = text.split_once('/').ok_or_else(bad)?;
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if i == 0 || i > n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
 impl SweepRequest {
-    /// Every (model, α, ρ, Ω/ω) of the grid, mass-spring first (it is quick).
+    /// Every (model, α, ρ, Ω/ω) of the grid (or of this request's shard), mass-spring
+    /// first (it is quick).
     pub fn jobs(&self) -> Vec<(ModelKind, f64, f64, f64)> {
         let mut jobs = Vec::new();
         for &model in &self.models {
@@ -107,7 +130,16 @@ impl SweepRequest {
                 }
             }
         }
-        jobs
+        match self.shard {
+            // Interleaved, so every shard gets a fair mix of quick and slow runs.
+            Some((i, n)) => jobs
+                .into_iter()
+                .enumerate()
+                .filter(|(k, _)| k % n == i - 1)
+                .map(|(_, j)| j)
+                .collect(),
+            None => jobs,
+        }
     }
 }
 
@@ -185,5 +217,35 @@ mod tests {
             vec![0.5, 2.0]
         );
         assert!(parse_list("--alpha", "0.1,x").is_err());
+    }
+
+    /// The shards of a grid are disjoint and together are the whole grid.
+    #[test]
+    fn shards_partition_the_grid() {
+        let mut req = SweepRequest {
+            alphas: vec![0.1, 0.5],
+            frictions: vec![0.05, 0.1, 0.25],
+            freq_ratios: vec![0.5, 1.0, 2.0],
+            amplitude_g: 0.3,
+            duration: 1.0,
+            dt: 1e-3,
+            integrator: Integrator::default(),
+            models: vec![ModelKind::MassSpring, ModelKind::Dda],
+            shard: None,
+        };
+        let all = req.jobs();
+        let mut joined = Vec::new();
+        for i in 1..=4 {
+            req.shard = Some((i, 4));
+            joined.extend(req.jobs());
+        }
+        assert_eq!(joined.len(), all.len());
+        for j in &all {
+            assert_eq!(joined.iter().filter(|k| *k == j).count(), 1);
+        }
+        assert_eq!(parse_shard("3/8").unwrap(), (3, 8));
+        for bad in ["0/4", "5/4", "x/4", "3"] {
+            assert!(parse_shard(bad).is_err(), "{bad}");
+        }
     }
 }

@@ -23,10 +23,14 @@ pub fn builtin_names() -> Vec<&'static str> {
     BUILTIN.iter().map(|(n, _)| *n).collect()
 }
 
-/// A built-in scene by name, or a scene file by path.
+/// A built-in scene by name, a generated one (`frame:N`, `wall:N`), or a scene file by
+/// path.
 pub fn resolve_scene(name_or_path: &str) -> Result<Scene> {
     if let Some((name, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
         return Scene::from_toml(text, &format!("<built-in {name}>"));
+    }
+    if let Some(generated) = super::generated::resolve_generated(name_or_path) {
+        return generated;
     }
     let path = Path::new(name_or_path);
     if path.exists() {
@@ -35,7 +39,7 @@ pub fn resolve_scene(name_or_path: &str) -> Result<Scene> {
     Err(Error::Unknown {
         kind: "scene",
         name: name_or_path.to_string(),
-        known: builtin_names().join(", "),
+        known: format!("{}, frame:N, wall:N", builtin_names().join(", ")),
     })
 }
 

@@ -1,0 +1,555 @@
+//! `slidebase bench`: how fast the solver is, measured the same way every time.
+//!
+//! Each workload is run several times and reported by its median (these machines are
+//! shared and noisy; the minimum is given too). The scaling series runs generated scenes
+//! of growing size (`frame:N`, `wall:N`) for a fixed window of simulated time and fits the
+//! exponent of time per step against the number of unknowns.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::frame::{FrameRequest, run_frame};
+use super::run::{RunRequest, run};
+use super::sweep::{SweepRequest, parse_ratios, run_sweep};
+use super::two_block::ModelKind;
+use crate::dda::{Dda, Integrator, SolverParams};
+use crate::ground_motion::{GroundMotion, resolve_record};
+use crate::model::presets::resolve_scene;
+use crate::post::plot::{Figure, Series};
+use crate::{Error, Result};
+
+/// What to measure.
+#[derive(Debug, Clone)]
+pub struct BenchOptions {
+    /// Fewer repeats, shorter windows, smaller scaling series and a reduced sweep.
+    pub quick: bool,
+    /// Repeats of each timed workload (the median is reported).
+    pub repeats: usize,
+    /// Threads for the sweep (0: all cores).
+    pub jobs: usize,
+    /// Run the Figs 4–9 sweep (the longest workload).
+    pub sweep: bool,
+    /// Run the scaling series.
+    pub scaling: bool,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        Self {
+            quick: false,
+            repeats: 5,
+            jobs: 0,
+            sweep: true,
+            scaling: true,
+        }
+    }
+}
+
+/// One timed workload.
+#[derive(Debug, Clone, Serialize)]
+pub struct Measurement {
+    /// What was run.
+    pub name: String,
+    /// How many times.
+    pub runs: usize,
+    /// Median wall time of one run, s.
+    pub median_s: f64,
+    /// Fastest run, s.
+    pub min_s: f64,
+    /// Time steps of one run (DDA) or propagation steps (exact model).
+    pub steps: u64,
+    /// Steps per second at the median.
+    pub steps_per_s: f64,
+    /// Simulated time of one run, s.
+    pub simulated_s: f64,
+    /// Simulated time / wall time at the median.
+    pub realtime_factor: f64,
+}
+
+/// The Figs 4–9 sweep, timed.
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepTiming {
+    /// Runs of each model.
+    pub runs_per_model: usize,
+    /// Threads used.
+    pub threads: usize,
+    /// Wall time of the whole sweep, s.
+    pub wall_s: f64,
+    /// Sum of the single-run wall times of the DDA runs, s.
+    pub dda_cpu_s: f64,
+    /// Sum of the single-run wall times of the exact runs, s.
+    pub exact_cpu_s: f64,
+    /// Runs that failed.
+    pub failures: usize,
+}
+
+/// One point of the scaling series.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScalingPoint {
+    /// Scene (`frame:N`, `wall:N`).
+    pub scene: String,
+    /// Family (`frame` or `wall`).
+    pub family: String,
+    /// Blocks (the ground included).
+    pub blocks: usize,
+    /// Unknowns of the system.
+    pub unknowns: usize,
+    /// Contacts found in the last step.
+    pub contacts: usize,
+    /// Model set-up and static settling, s.
+    pub setup_s: f64,
+    /// Steps timed.
+    pub steps: u64,
+    /// Mean wall time per step, ms.
+    pub mean_step_ms: f64,
+    /// Median wall time per step, ms.
+    pub median_step_ms: f64,
+    /// Factorisations of the system matrix in the window.
+    pub factorizations: u64,
+}
+
+/// Least-squares fit of log(time per step) against log(unknowns).
+#[derive(Debug, Clone, Serialize)]
+pub struct ExponentFit {
+    /// Which points.
+    pub family: String,
+    /// Fitted exponent (1 = linear).
+    pub exponent: f64,
+    /// Points in the fit.
+    pub points: usize,
+}
+
+/// Everything `slidebase bench` measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchReport {
+    /// Cores seen by the program.
+    pub cores: usize,
+    /// The timed workloads.
+    pub workloads: Vec<Measurement>,
+    /// The sweep, if run.
+    pub sweep: Option<SweepTiming>,
+    /// The scaling series.
+    pub scaling: Vec<ScalingPoint>,
+    /// Exponents of time per step against unknowns.
+    pub exponents: Vec<ExponentFit>,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// Runs `f` `repeats` times; `f` returns (wall time, steps, simulated time).
+fn measure(
+    name: &str,
+    repeats: usize,
+    mut f: impl FnMut() -> Result<(f64, u64, f64)>,
+) -> Result<Measurement> {
+    let mut times = Vec::with_capacity(repeats);
+    let (mut steps, mut simulated) = (0, 0.0);
+    for _ in 0..repeats.max(1) {
+        let (t, s, sim) = f()?;
+        times.push(t);
+        (steps, simulated) = (s, sim);
+    }
+    let min_s = times.iter().copied().fold(f64::INFINITY, f64::min);
+    let median_s = median(times.clone());
+    Ok(Measurement {
+        name: name.into(),
+        runs: times.len(),
+        median_s,
+        min_s,
+        steps,
+        steps_per_s: steps as f64 / median_s,
+        simulated_s: simulated,
+        realtime_factor: simulated / median_s,
+    })
+}
+
+/// The paper's two-block model (α = 0.5, ρ = 0.1, resonance, 0.3 g, 100 s).
+fn two_block(model: ModelKind) -> Result<(f64, u64, f64)> {
+    let req = RunRequest {
+        duration: Some(100.0),
+        record_every: 0,
+        model,
+        ..RunRequest::default()
+    };
+    let start = Instant::now();
+    let o = run(&req)?;
+    Ok((start.elapsed().as_secs_f64(), o.summary.steps, 100.0))
+}
+
+/// The three-storey frame on El Centro, Δt = 1 ms.
+fn three_storey(fixed_base: bool) -> Result<(f64, u64, f64)> {
+    let req = FrameRequest {
+        fixed_base,
+        ..FrameRequest::default()
+    };
+    let start = Instant::now();
+    let o = run_frame(&req)?;
+    Ok((
+        start.elapsed().as_secs_f64(),
+        o.summary.steps,
+        o.summary.duration_s,
+    ))
+}
+
+/// One scaling point: the scene under El Centro for `window` seconds after settling.
+pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
+    let scene = resolve_scene(scene_name)?;
+    let record = resolve_record("el-centro")?;
+    let motion = GroundMotion::Record(Arc::new(record));
+    let setup = Instant::now();
+    let mut dda = Dda::new(
+        &scene,
+        Some(motion),
+        SolverParams {
+            duration: window,
+            ..SolverParams::default()
+        },
+    )?;
+    let setup_s = setup.elapsed().as_secs_f64();
+    let before = dda.counters();
+    let mut step_times = Vec::new();
+    let start = Instant::now();
+    let mut last = Instant::now();
+    dda.run_until(window, |_, _| {
+        let now = Instant::now();
+        step_times.push(now.duration_since(last).as_secs_f64());
+        last = now;
+    })?;
+    let total = start.elapsed().as_secs_f64();
+    let after = dda.counters();
+    let steps = after.steps - before.steps;
+    Ok(ScalingPoint {
+        scene: scene_name.into(),
+        family: scene_name.split(':').next().unwrap_or("").into(),
+        blocks: dda.blocks().len(),
+        unknowns: dda.unknowns(),
+        contacts: dda.last_report().contacts,
+        setup_s,
+        steps,
+        mean_step_ms: 1e3 * total / steps.max(1) as f64,
+        median_step_ms: 1e3 * median(step_times),
+        factorizations: after.factorizations - before.factorizations,
+    })
+}
+
+/// Least-squares slope of log(y) against log(x).
+pub fn fit_exponent(points: &[(f64, f64)]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+        .map(|(x, y)| (x.ln(), y.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// Runs the benchmark; `progress` is told what runs next.
+pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<BenchReport> {
+    let repeats = if options.quick { 3 } else { options.repeats };
+    let mut workloads = Vec::new();
+    progress("two-block DDA, 100 s");
+    workloads.push(measure(
+        "two-block DDA (α = 0.5, ρ = 0.1, Ω = ω, 0.3 g), 100 s, Δt = 1 ms",
+        repeats,
+        || two_block(ModelKind::Dda),
+    )?);
+    progress("two-block exact model, 100 s");
+    workloads.push(measure(
+        "two-block exact mass-spring model, 100 s",
+        repeats,
+        || two_block(ModelKind::MassSpring),
+    )?);
+    progress("three-storey El Centro, sliding base");
+    workloads.push(measure(
+        "three-storey El Centro, sliding base (ρ = 0.01), Δt = 1 ms",
+        repeats,
+        || three_storey(false),
+    )?);
+    progress("three-storey El Centro, fixed base");
+    workloads.push(measure(
+        "three-storey El Centro, fixed base, Δt = 1 ms",
+        repeats,
+        || three_storey(true),
+    )?);
+    let sweep = if options.sweep {
+        progress("Figs 4–9 sweep");
+        Some(time_sweep(options)?)
+    } else {
+        None
+    };
+    let mut scaling = Vec::new();
+    if options.scaling {
+        let (window, scenes): (f64, &[&str]) = if options.quick {
+            (
+                0.1,
+                &[
+                    "frame:3", "frame:10", "frame:30", "wall:5", "wall:10", "wall:20",
+                ],
+            )
+        } else {
+            (
+                0.5,
+                &[
+                    "frame:3",
+                    "frame:10",
+                    "frame:30",
+                    "frame:100",
+                    "wall:5",
+                    "wall:10",
+                    "wall:15",
+                    "wall:22",
+                    "wall:31",
+                ],
+            )
+        };
+        for scene in scenes {
+            progress(&format!("scaling: {scene}"));
+            scaling.push(scaling_point(scene, window)?);
+        }
+    }
+    let mut exponents = Vec::new();
+    for family in ["frame", "wall", "all"] {
+        let pts: Vec<(f64, f64)> = scaling
+            .iter()
+            .filter(|p| family == "all" || p.family == family)
+            .map(|p| (p.unknowns as f64, p.mean_step_ms))
+            .collect();
+        if let Some(exponent) = fit_exponent(&pts) {
+            exponents.push(ExponentFit {
+                family: family.into(),
+                exponent,
+                points: pts.len(),
+            });
+        }
+    }
+    Ok(BenchReport {
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        workloads,
+        sweep,
+        scaling,
+        exponents,
+    })
+}
+
+/// The paper's grid (quick: a 2 × 2 × 5 corner of it), both models, on the thread pool.
+fn time_sweep(options: &BenchOptions) -> Result<SweepTiming> {
+    let (alphas, frictions, ratios) = if options.quick {
+        (
+            vec![0.1, 0.9],
+            vec![0.05, 0.25],
+            parse_ratios("", "0.1:10:5")?,
+        )
+    } else {
+        (
+            vec![0.1, 0.5, 0.9],
+            vec![0.01, 0.05, 0.1, 0.25],
+            parse_ratios("", "0.1:10:25")?,
+        )
+    };
+    let req = SweepRequest {
+        alphas,
+        frictions,
+        freq_ratios: ratios,
+        amplitude_g: 0.3,
+        duration: 100.0,
+        dt: 1e-3,
+        integrator: Integrator::default(),
+        models: vec![ModelKind::MassSpring, ModelKind::Dda],
+        shard: None,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.jobs)
+        .build()
+        .map_err(|e| Error::invalid("--jobs", e.to_string()))?;
+    let threads = pool.current_num_threads();
+    let start = Instant::now();
+    let (rows, failures) = pool.install(|| run_sweep(&req, &|| {}));
+    let wall_s = start.elapsed().as_secs_f64();
+    let cpu = |model: &str| {
+        rows.iter()
+            .filter(|r| r.model == model)
+            .map(|r| r.wall_time_s)
+            .sum()
+    };
+    Ok(SweepTiming {
+        runs_per_model: req.jobs().len() / 2,
+        threads,
+        wall_s,
+        dda_cpu_s: cpu("dda"),
+        exact_cpu_s: cpu("mass-spring"),
+        failures: failures.len(),
+    })
+}
+
+/// The report as a text table.
+pub fn report_text(r: &BenchReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "slidebase bench ({} cores)\n", r.cores);
+    let _ = writeln!(
+        s,
+        "{:<66} {:>10} {:>10} {:>12} {:>9}",
+        "workload", "median s", "min s", "steps/s", "× real"
+    );
+    for m in &r.workloads {
+        let _ = writeln!(
+            s,
+            "{:<66} {:>10.4} {:>10.4} {:>12.0} {:>9.1}",
+            m.name, m.median_s, m.min_s, m.steps_per_s, m.realtime_factor
+        );
+    }
+    if let Some(sw) = &r.sweep {
+        let _ = writeln!(
+            s,
+            "\nFigs 4–9 sweep: {} runs of each model on {} threads in {:.1} s wall \
+             (DDA {:.1} s, exact {:.1} s of single-run time; {} failed)",
+            sw.runs_per_model, sw.threads, sw.wall_s, sw.dda_cpu_s, sw.exact_cpu_s, sw.failures
+        );
+    }
+    if !r.scaling.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n{:<10} {:>7} {:>9} {:>9} {:>9} {:>7} {:>13} {:>15} {:>7}",
+            "scene",
+            "blocks",
+            "unknowns",
+            "contacts",
+            "setup s",
+            "steps",
+            "mean ms/step",
+            "median ms/step",
+            "factor."
+        );
+        for p in &r.scaling {
+            let _ = writeln!(
+                s,
+                "{:<10} {:>7} {:>9} {:>9} {:>9.3} {:>7} {:>13.3} {:>15.3} {:>7}",
+                p.scene,
+                p.blocks,
+                p.unknowns,
+                p.contacts,
+                p.setup_s,
+                p.steps,
+                p.mean_step_ms,
+                p.median_step_ms,
+                p.factorizations
+            );
+        }
+        for e in &r.exponents {
+            let _ = writeln!(
+                s,
+                "time per step ∝ unknowns^{:.2} ({}, {} points)",
+                e.exponent, e.family, e.points
+            );
+        }
+    }
+    s
+}
+
+/// Writes `bench.json`, `scaling.csv` and `scaling.png` into `out`.
+pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let json = out.join("bench.json");
+    let text = serde_json::to_string_pretty(r)
+        .map_err(|e| Error::Scene(format!("cannot serialise the report: {e}")))?;
+    std::fs::write(&json, text).map_err(|e| Error::io(&json, e))?;
+    let mut files = vec![json];
+    if r.scaling.is_empty() {
+        return Ok(files);
+    }
+    let csv_path = out.join("scaling.csv");
+    let csv_error = |e: csv::Error| Error::Scene(format!("{}: {e}", csv_path.display()));
+    let mut w = csv::Writer::from_path(&csv_path).map_err(csv_error)?;
+    for p in &r.scaling {
+        w.serialize(p).map_err(csv_error)?;
+    }
+    w.flush().map_err(|e| Error::io(&csv_path, e))?;
+    files.push(csv_path);
+    let mut fig = Figure::new("Time per step against the size of the model", 1, 1);
+    let p = &mut fig.panels[0];
+    p.x_label = "unknowns (6 per block)".into();
+    p.y_label = "mean wall time per step (ms)".into();
+    p.x_log = true;
+    p.y_log = true;
+    for (k, family) in ["frame", "wall"].iter().enumerate() {
+        let pts: Vec<&ScalingPoint> = r.scaling.iter().filter(|p| p.family == *family).collect();
+        if pts.is_empty() {
+            continue;
+        }
+        let exponent = r
+            .exponents
+            .iter()
+            .find(|e| e.family == *family)
+            .map_or(String::new(), |e| format!(" (∝ n^{:.2})", e.exponent));
+        let label = match *family {
+            "frame" => format!("N-storey frames{exponent}"),
+            _ => format!("walls of N courses{exponent}"),
+        };
+        p.series.push(Series::markers(
+            label,
+            pts.iter().map(|p| p.unknowns as f64).collect(),
+            pts.iter().map(|p| p.mean_step_ms).collect(),
+            k,
+        ));
+    }
+    // A linear reference through the smallest point.
+    if let Some(first) = r.scaling.iter().min_by_key(|p| p.unknowns) {
+        let largest = r
+            .scaling
+            .iter()
+            .map(|p| p.unknowns)
+            .max()
+            .unwrap_or(first.unknowns);
+        let x = vec![first.unknowns as f64, largest as f64];
+        let y = x
+            .iter()
+            .map(|v| first.mean_step_ms * v / first.unknowns as f64)
+            .collect();
+        p.series.push(Series::line("linear", x, y, 6));
+    }
+    let png = out.join("scaling.png");
+    fig.save_png(&png, 1000, 700)?;
+    files.push(png);
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exponent_of_a_power_law() {
+        let pts: Vec<(f64, f64)> = [10.0, 100.0, 1000.0]
+            .iter()
+            .map(|&x: &f64| (x, 3.0 * x.powf(1.3)))
+            .collect();
+        let e = fit_exponent(&pts).unwrap();
+        assert!((e - 1.3).abs() < 1e-12);
+        assert!(fit_exponent(&pts[..1]).is_none());
+    }
+
+    #[test]
+    fn median_of_even_and_odd() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), 2.5);
+    }
+}
