@@ -201,3 +201,22 @@ fn loading_a_bad_record_file_shows_an_error() {
     assert_eq!(r.len(), 1);
     assert!(state.error.is_none());
 }
+
+/// Regression: the default view stopped itself at t ≈ 0.1 s. The time slider shows two
+/// decimals and rounded the playing time to them, which egui reports as a change of the
+/// slider; that was taken for the user scrubbing, which pauses playback.
+#[test]
+fn playback_runs_on_by_itself() {
+    let ctx = egui::Context::default();
+    let mut state = AppState::default();
+    state.take_commands();
+    synthetic_run(&mut state);
+    assert!(state.playing, "the visualizer opens playing");
+    for _ in 0..30 {
+        state.advance(0.0137);
+        pass(&ctx, &mut state, vec![]);
+    }
+    assert!(state.playing, "nothing but the user pauses playback");
+    let t = state.play_time;
+    assert!((t - 30.0 * 0.0137).abs() < 1e-9, "played to {t}");
+}

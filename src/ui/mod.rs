@@ -586,7 +586,10 @@ impl AppState {
                 .fixed_decimals(2);
             let r = ui.add_sized([ui.available_width() * 0.55, 20.0], slider);
             self.widget_rects.insert("time", r.rect);
-            if r.changed() {
+            // Only the user moves the cursor: the slider also reports a change when it
+            // rounds the playing time to its two decimals, which must not pause playback.
+            let by_user = r.dragged() || r.drag_stopped() || r.clicked() || r.has_focus();
+            if r.changed() && by_user {
                 self.play_time = t.min(available);
                 self.playing = false;
             }
