@@ -17,8 +17,13 @@ use slidebase::model::presets::resolve_scene;
 
 fn two_block(c: &mut Criterion) {
     let mut group = c.benchmark_group("two-block");
-    group.sample_size(10).measurement_time(Duration::from_secs(8));
-    for (name, model) in [("dda 10 s", ModelKind::Dda), ("exact 10 s", ModelKind::MassSpring)] {
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(8));
+    for (name, model) in [
+        ("dda 10 s", ModelKind::Dda),
+        ("exact 10 s", ModelKind::MassSpring),
+    ] {
         let req = RunRequest {
             duration: Some(10.0),
             record_every: 0,
@@ -46,7 +51,9 @@ fn model(scene: &str) -> Option<Dda> {
 
 fn steps(c: &mut Criterion) {
     let mut group = c.benchmark_group("100 steps");
-    group.sample_size(10).measurement_time(Duration::from_secs(8));
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(8));
     for scene in ["three-storey", "frame:30", "wall:10"] {
         let Some(start) = model(scene) else {
             eprintln!("cannot build {scene}");

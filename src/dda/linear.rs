@@ -457,34 +457,60 @@ enum Factor {
 /// pattern and its last numeric factor (see the module documentation).
 pub struct LinearSolver {
     pattern: Arc<BlockPattern>,
-    factor: Factor,
+    /// Two kept factors, least recently used replaced first: one for the nominal step and
+    /// one for the odd step (a step shortened to land on an event, or cut), so that an odd
+    /// step does not throw away the factor the next nominal step needs.
+    slots: [Slot; 2],
+    /// The slot the current solve uses.
+    active: usize,
     scratch: MemBuffer,
-    /// The factor holds a matrix of the structure identified by this key.
-    factored: Option<u64>,
     /// CG iterations one factorisation is worth (see [`iteration_budget`]).
     budget: usize,
-    /// CG iterations spent since the last factorisation.
-    spent: usize,
     /// CG work vectors: residual, preconditioned residual, direction, K·direction.
     work: [Vec<f64>; 4],
     stats: SolverStats,
+}
+
+/// A kept factor and what it is for.
+struct Slot {
+    factor: Factor,
+    /// The factor holds a matrix of the structure identified by this key.
+    factored: Option<u64>,
+    /// CG iterations spent on this factor since it was made.
+    spent: usize,
+    /// When it was last used (the solver's solve count).
+    used: u64,
+}
+
+impl Slot {
+    fn new(factor: Factor) -> Self {
+        Self {
+            factor,
+            factored: None,
+            spent: 0,
+            used: 0,
+        }
+    }
 }
 
 impl std::fmt::Debug for LinearSolver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LinearSolver")
             .field("unknowns", &self.pattern.unknowns())
-            .field("sparse", &matches!(self.factor, Factor::Sparse { .. }))
-            .field("tiny", &matches!(self.factor, Factor::Tiny(_)))
+            .field(
+                "sparse",
+                &matches!(self.slots[0].factor, Factor::Sparse { .. }),
+            )
+            .field("tiny", &matches!(self.slots[0].factor, Factor::Tiny(_)))
             .field("stats", &self.stats)
             .finish()
     }
 }
 
-impl Clone for LinearSolver {
-    /// A solver for the same pattern (sharing the symbolic analysis) with no factor.
-    fn clone(&self) -> Self {
-        let factor = match &self.factor {
+impl Factor {
+    /// An empty factor of the same kind and size (sharing the symbolic analysis).
+    fn empty_like(&self) -> Self {
+        match self {
             Factor::Tiny(t) => Factor::Tiny(match t {
                 Tiny::B1(_) => Tiny::B1(None),
                 Tiny::B2(_) => Tiny::B2(None),
@@ -503,14 +529,20 @@ impl Clone for LinearSolver {
                 l_values: vec![0.0; l_values.len()],
                 a_values: vec![0.0; a_values.len()],
             },
-        };
+        }
+    }
+}
+
+impl Clone for LinearSolver {
+    /// A solver for the same pattern (sharing the symbolic analysis) with no factor.
+    fn clone(&self) -> Self {
+        let factor = self.slots[0].factor.empty_like();
         Self {
             pattern: Arc::clone(&self.pattern),
             scratch: MemBuffer::new(scratch_size(&factor, self.pattern.unknowns())),
-            factor,
-            factored: None,
+            slots: [Slot::new(factor.empty_like()), Slot::new(factor)],
+            active: 0,
             budget: self.budget,
-            spent: 0,
             work: self.work.clone(),
             stats: self.stats,
         }
@@ -571,10 +603,9 @@ impl LinearSolver {
         };
         Ok(Self {
             scratch: MemBuffer::new(scratch_size(&factor, n)),
-            factor,
-            factored: None,
+            slots: [Slot::new(factor.empty_like()), Slot::new(factor)],
+            active: 0,
             budget,
-            spent: 0,
             work: std::array::from_fn(|_| vec![0.0; n]),
             stats: SolverStats::default(),
             pattern,
@@ -586,9 +617,11 @@ impl LinearSolver {
         self.stats
     }
 
-    /// Forgets the kept factor.
+    /// Forgets the kept factors.
     pub fn invalidate(&mut self) {
-        self.factored = None;
+        for slot in &mut self.slots {
+            slot.factored = None;
+        }
     }
 
     /// Solves K x = rhs. `structure` identifies what makes the matrix change by more
@@ -605,14 +638,29 @@ impl LinearSolver {
             return Err(SolveError::OutsidePattern);
         }
         self.stats.solves += 1;
-        if self.factored == Some(structure) && self.spent < self.budget && self.iterate(k, rhs, x) {
-            return Ok(());
+        let kept = (0..2).find(|&i| self.slots[i].factored == Some(structure));
+        if let Some(i) = kept {
+            self.active = i;
+            self.slots[i].used = self.stats.solves;
+            if self.slots[i].spent < self.budget && self.iterate(k, rhs, x) {
+                return Ok(());
+            }
         }
         if !k.is_finite() || rhs.iter().any(|v| !v.is_finite()) {
             return Err(SolveError::NonFinite);
         }
+        // Refactorise the slot of this structure, or the one used least recently.
+        self.active = kept.unwrap_or_else(|| {
+            if self.slots[0].used <= self.slots[1].used {
+                0
+            } else {
+                1
+            }
+        });
         self.factorize(k)?;
-        self.factored = Some(structure);
+        let slot = &mut self.slots[self.active];
+        slot.factored = Some(structure);
+        slot.used = self.stats.solves;
         x.copy_from_slice(rhs);
         self.apply_inverse(x);
         Ok(())
@@ -638,7 +686,7 @@ impl LinearSolver {
         p.copy_from_slice(&z);
         let mut rz = dot(&r, &z);
         let mut converged = false;
-        let allowed = self.budget - self.spent;
+        let allowed = self.budget - self.slots[self.active].spent;
         for iteration in 0..=allowed {
             let (r_norm, x_norm) = (norm(&r), norm(x));
             if !r_norm.is_finite() {
@@ -660,7 +708,7 @@ impl LinearSolver {
                 break;
             }
             self.stats.iterations += 1;
-            self.spent += 1;
+            self.slots[self.active].spent += 1;
             k.mul(&p, &mut q);
             let pq = dot(&p, &q);
             // Not positive (or NaN): the matrix is not what the factor was made for.
@@ -687,10 +735,11 @@ impl LinearSolver {
 
     fn factorize(&mut self, k: &BlockMatrix) -> Result<(), SolveError> {
         self.stats.factorizations += 1;
-        self.factored = None;
-        self.spent = 0;
+        let slot = &mut self.slots[self.active];
+        slot.factored = None;
+        slot.spent = 0;
         let stack = MemStack::new(&mut self.scratch);
-        match &mut self.factor {
+        match &mut slot.factor {
             Factor::Tiny(tiny) => tiny.factorize(k)?,
             Factor::Dense { l } => {
                 k.fill_dense_lower(l.as_mut());
@@ -729,13 +778,14 @@ impl LinearSolver {
     /// x ← K⁻¹ x with the kept factor.
     fn apply_inverse(&mut self, x: &mut [f64]) {
         let n = x.len();
-        if let Factor::Tiny(tiny) = &self.factor {
+        let factor = &self.slots[self.active].factor;
+        if let Factor::Tiny(tiny) = factor {
             tiny.solve(x);
             return;
         }
         let mut rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
         let stack = MemStack::new(&mut self.scratch);
-        match &self.factor {
+        match factor {
             Factor::Tiny(_) => {}
             Factor::Dense { l } => {
                 faer::linalg::cholesky::llt::solve::solve_in_place(

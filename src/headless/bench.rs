@@ -117,8 +117,11 @@ pub struct ScalingPoint {
 pub struct ExponentFit {
     /// Which points.
     pub family: String,
-    /// Fitted exponent (1 = linear).
+    /// Fitted exponent of the mean time per step (1 = linear).
     pub exponent: f64,
+    /// Fitted exponent of the median time per step: the typical step, without the rare
+    /// ones that factorise the matrix again (after a step cut or landed on an event).
+    pub exponent_median: f64,
     /// Points in the fit.
     pub points: usize,
 }
@@ -329,16 +332,20 @@ pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Benc
     }
     let mut exponents = Vec::new();
     for family in ["frame", "wall", "all"] {
-        let pts: Vec<(f64, f64)> = scaling
-            .iter()
-            .filter(|p| family == "all" || p.family == family)
-            .map(|p| (p.unknowns as f64, p.mean_step_ms))
-            .collect();
-        if let Some(exponent) = fit_exponent(&pts) {
+        let of = |f: fn(&ScalingPoint) -> f64| -> Vec<(f64, f64)> {
+            scaling
+                .iter()
+                .filter(|p| family == "all" || p.family == family)
+                .map(|p| (p.unknowns as f64, f(p)))
+                .collect()
+        };
+        let (mean, med) = (of(|p| p.mean_step_ms), of(|p| p.median_step_ms));
+        if let (Some(exponent), Some(exponent_median)) = (fit_exponent(&mean), fit_exponent(&med)) {
             exponents.push(ExponentFit {
                 family: family.into(),
                 exponent,
-                points: pts.len(),
+                exponent_median,
+                points: mean.len(),
             });
         }
     }
@@ -457,8 +464,8 @@ pub fn report_text(r: &BenchReport) -> String {
         for e in &r.exponents {
             let _ = writeln!(
                 s,
-                "time per step ∝ unknowns^{:.2} ({}, {} points)",
-                e.exponent, e.family, e.points
+                "time per step ∝ unknowns^{:.2} (mean), ^{:.2} (median) ({}, {} points)",
+                e.exponent, e.exponent_median, e.family, e.points
             );
         }
     }
@@ -487,7 +494,7 @@ pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
     let mut fig = Figure::new("Time per step against the size of the model", 1, 1);
     let p = &mut fig.panels[0];
     p.x_label = "unknowns (6 per block)".into();
-    p.y_label = "mean wall time per step (ms)".into();
+    p.y_label = "wall time per step (ms)".into();
     p.x_log = true;
     p.y_log = true;
     for (k, family) in ["frame", "wall"].iter().enumerate() {
@@ -495,19 +502,30 @@ pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
         if pts.is_empty() {
             continue;
         }
-        let exponent = r
-            .exponents
-            .iter()
-            .find(|e| e.family == *family)
-            .map_or(String::new(), |e| format!(" (∝ n^{:.2})", e.exponent));
+        let exponent =
+            r.exponents
+                .iter()
+                .find(|e| e.family == *family)
+                .map_or(String::new(), |e| {
+                    format!(
+                        " (∝ n^{:.2} mean, n^{:.2} median)",
+                        e.exponent, e.exponent_median
+                    )
+                });
         let label = match *family {
             "frame" => format!("N-storey frames{exponent}"),
             _ => format!("walls of N courses{exponent}"),
         };
         p.series.push(Series::markers(
-            label,
+            format!("{label}, mean"),
             pts.iter().map(|p| p.unknowns as f64).collect(),
             pts.iter().map(|p| p.mean_step_ms).collect(),
+            k,
+        ));
+        p.series.push(Series::line(
+            format!("{label}, median"),
+            pts.iter().map(|p| p.unknowns as f64).collect(),
+            pts.iter().map(|p| p.median_step_ms).collect(),
             k,
         ));
     }
