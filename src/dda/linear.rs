@@ -177,42 +177,44 @@ impl BlockMatrix {
     /// term, and the lower one is the transpose of the upper.
     #[inline]
     pub fn add(&mut self, bi: usize, bj: usize, m: &Mat6, scale: f64) {
-        if bi > bj {
-            return;
-        }
-        match self.pattern.entry(bi, bj) {
-            Some(e) => {
-                let b = &mut self.blocks[e];
-                for r in 0..6 {
-                    for c in 0..6 {
-                        b[r][c] += scale * m[r][c];
-                    }
+        if let Some(b) = self.upper_block(bi, bj) {
+            for r in 0..6 {
+                for c in 0..6 {
+                    b[r][c] += scale * m[r][c];
                 }
             }
-            None => self.outside_pattern = true,
         }
     }
 
     /// Adds `scale · u vᵀ` to block (bi, bj) (same storage rule as [`BlockMatrix::add`]).
     #[inline]
     pub fn add_outer(&mut self, bi: usize, bj: usize, u: &[f64; 6], v: &[f64; 6], scale: f64) {
-        if bi > bj {
-            return;
-        }
-        match self.pattern.entry(bi, bj) {
-            Some(e) => {
-                let b = &mut self.blocks[e];
-                for r in 0..6 {
-                    let s = scale * u[r];
-                    if s == 0.0 {
-                        continue;
-                    }
-                    for c in 0..6 {
-                        b[r][c] += s * v[c];
-                    }
+        if let Some(b) = self.upper_block(bi, bj) {
+            for r in 0..6 {
+                let s = scale * u[r];
+                if s == 0.0 {
+                    continue;
+                }
+                for c in 0..6 {
+                    b[r][c] += s * v[c];
                 }
             }
-            None => self.outside_pattern = true,
+        }
+    }
+
+    /// The stored block (bi, bj) when bi ≤ bj; `None` for the lower triangle (not stored)
+    /// and, marking the matrix, for a block outside the pattern.
+    #[inline]
+    fn upper_block(&mut self, bi: usize, bj: usize) -> Option<&mut Mat6> {
+        if bi > bj {
+            return None;
+        }
+        match self.pattern.entry(bi, bj) {
+            Some(e) => Some(&mut self.blocks[e]),
+            None => {
+                self.outside_pattern = true;
+                None
+            }
         }
     }
 

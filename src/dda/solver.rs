@@ -388,11 +388,9 @@ impl Dda {
         Ok(model)
     }
 
-    /// Refuses a scene whose blocks overlap at the start by more than a rounding error of
-    /// the geometry: the penalty springs would throw them apart with an energy the scene
-    /// never had (a vertex 1 cm inside a block on a 1e12 N/m spring stores 50 MJ).
-    fn check_initial_overlap(&mut self) -> Result<()> {
-        let tolerance = 1e-6 * self.structure_size;
+    /// Finds the contacts of the current geometry (carrying over the memory of the last
+    /// step's).
+    fn detect_contacts(&mut self) {
         contact::detect(
             &self.blocks,
             &self.pairs,
@@ -400,6 +398,14 @@ impl Dda {
             self.search_distance,
             &mut self.contacts,
         );
+    }
+
+    /// Refuses a scene whose blocks overlap at the start by more than a rounding error of
+    /// the geometry: the penalty springs would throw them apart with an energy the scene
+    /// never had (a vertex 1 cm inside a block on a 1e12 N/m spring stores 50 MJ).
+    fn check_initial_overlap(&mut self) -> Result<()> {
+        let tolerance = 1e-6 * self.structure_size;
+        self.detect_contacts();
         let worst = self
             .contacts
             .iter()
@@ -1015,13 +1021,7 @@ impl Dda {
 
     fn settle_with(&mut self, friction: Option<f64>) -> Result<()> {
         let known = vec![[0.0; 6]; self.blocks.len()];
-        contact::detect(
-            &self.blocks,
-            &self.pairs,
-            &self.memory,
-            self.search_distance,
-            &mut self.contacts,
-        );
+        self.detect_contacts();
         let Some((increments, _)) = self.iterate(Mode::Static { friction }, &known)? else {
             return Err(Error::Solver {
                 time: 0.0,
@@ -1218,13 +1218,7 @@ impl Dda {
             let dt = dt_override.unwrap_or(self.dt_current).min(max_dt);
             let mode = Mode::Dynamic { dt };
             let known = self.known_increments(mode);
-            contact::detect(
-                &self.blocks,
-                &self.pairs,
-                &self.memory,
-                self.search_distance,
-                &mut self.contacts,
-            );
+            self.detect_contacts();
             let outcome = self.iterate(mode, &known)?;
             // Land the step on a stick-slip (or impact) event: a transition assumed at the
             // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
@@ -1602,13 +1596,7 @@ impl Dda {
     /// Out-of-balance force f_ext − f_int at the current state with every touching contact
     /// stuck: the right-hand side of a static step with zero increment.
     fn out_of_balance(&mut self) -> DVector<f64> {
-        contact::detect(
-            &self.blocks,
-            &self.pairs,
-            &self.memory,
-            self.search_distance,
-            &mut self.contacts,
-        );
+        self.detect_contacts();
         for c in &mut self.contacts {
             if c.gap0 <= 0.0 || c.state.is_closed() {
                 c.state = ContactState::Locked;

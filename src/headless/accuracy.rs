@@ -164,14 +164,8 @@ fn two_block_row(
     converged: Option<&TwoBlockRun>,
 ) -> Result<AccuracyRow> {
     let req = RunRequest {
-        alpha: case.alpha,
-        friction: case.friction,
-        freq_ratio: case.ratio,
-        duration: Some(duration),
-        dt,
         integrator,
-        fixed_base,
-        ..RunRequest::default()
+        ..case_request(case, duration, dt, fixed_base)
     };
     let mut setup = two_block_setup(&req)?;
     if let Some(p) = penalty {
@@ -239,6 +233,19 @@ fn two_block_row(
     })
 }
 
+/// The run request of a case (default integrator).
+fn case_request(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> RunRequest {
+    RunRequest {
+        alpha: case.alpha,
+        friction: case.friction,
+        freq_ratio: case.ratio,
+        duration: Some(duration),
+        dt,
+        fixed_base,
+        ..RunRequest::default()
+    }
+}
+
 /// Histories are compared every 0.5 ms: fine enough that interpolating them costs less
 /// than 1e-6 D.
 const SAMPLE_DT: f64 = 5e-4;
@@ -251,15 +258,7 @@ fn record_every(dt: f64) -> usize {
 /// the time step alone costs: as Δt → 0 every scheme tends to it, and it differs from the
 /// exact mass-spring solution only by the model (penalty springs at the joint).
 fn converged_dda(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> Result<TwoBlockRun> {
-    let req = RunRequest {
-        alpha: case.alpha,
-        friction: case.friction,
-        freq_ratio: case.ratio,
-        duration: Some(duration),
-        dt,
-        fixed_base,
-        ..RunRequest::default()
-    };
+    let req = case_request(case, duration, dt, fixed_base);
     let setup = two_block_setup(&req)?;
     let params = SolverParams {
         dt,

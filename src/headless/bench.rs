@@ -246,24 +246,10 @@ pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
     })
 }
 
-/// Least-squares slope of log(y) against log(x).
+/// Least-squares slope of log(y) against log(x) (the same fit as the observed order of
+/// convergence).
 pub fn fit_exponent(points: &[(f64, f64)]) -> Option<f64> {
-    let pts: Vec<(f64, f64)> = points
-        .iter()
-        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
-        .map(|(x, y)| (x.ln(), y.ln()))
-        .collect();
-    if pts.len() < 2 {
-        return None;
-    }
-    let n = pts.len() as f64;
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / n,
-        pts.iter().map(|p| p.1).sum::<f64>() / n,
-    );
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
+    super::accuracy::observed_order(points, 0.0)
 }
 
 /// Runs the benchmark; `progress` is told what runs next.

@@ -161,19 +161,11 @@ pub fn frame(storeys: usize) -> Result<Scene> {
         }
         floors.push(floor);
     }
-    let scene = Scene {
-        name: format!("frame:{storeys}"),
-        description: format!(
-            "The paper's frame with {storeys} storeys on a sliding base slab (generated)"
-        ),
-        gravity: STANDARD_GRAVITY,
+    building(
+        format!("frame:{storeys}"),
+        format!("The paper's frame with {storeys} storeys on a sliding base slab (generated)"),
         blocks,
-        ground: GroundDef {
-            block: "ground".into(),
-            kind: GroundKind::Prescribed,
-            mass_ratio: 1e4,
-        },
-        contacts: vec![ContactDef {
+        vec![ContactDef {
             name: "sliding-joint".into(),
             blocks: ["base-slab".into(), "ground".into()],
             friction: 0.01,
@@ -181,6 +173,32 @@ pub fn frame(storeys: usize) -> Result<Scene> {
             shear_penalty: Some(2.0e12),
             bonded: false,
         }],
+        connections,
+        floors,
+    )
+}
+
+/// A building scene on the ground block `ground`, with a base slab `base-slab` on the
+/// contact `sliding-joint`, under El Centro; `floors` name the levels above the base.
+fn building(
+    name: String,
+    description: String,
+    blocks: Vec<BlockDef>,
+    contacts: Vec<ContactDef>,
+    connections: Vec<ConnectionDef>,
+    floors: Vec<String>,
+) -> Result<Scene> {
+    let scene = Scene {
+        name,
+        description,
+        gravity: STANDARD_GRAVITY,
+        blocks,
+        ground: GroundDef {
+            block: "ground".into(),
+            kind: GroundKind::Prescribed,
+            mass_ratio: 1e4,
+        },
+        contacts,
         bolts: Vec::new(),
         connections,
         fixed_points: Vec::new(),
@@ -288,37 +306,17 @@ pub fn wall(n: usize) -> Result<Scene> {
         }
         below = this;
     }
-    let scene = Scene {
-        name: format!("wall:{n}"),
-        description: format!(
+    building(
+        format!("wall:{n}"),
+        format!(
             "A wall of {n} courses of dry-stacked blocks in running bond on a sliding base slab \
              (generated)"
         ),
-        gravity: STANDARD_GRAVITY,
         blocks,
-        ground: GroundDef {
-            block: "ground".into(),
-            kind: GroundKind::Prescribed,
-            mass_ratio: 1e4,
-        },
         contacts,
-        bolts: Vec::new(),
-        connections: Vec::new(),
-        fixed_points: Vec::new(),
-        point_loads: Vec::new(),
-        excitation: ExcitationDef::Record {
-            record: "el-centro".into(),
-            scale: 1.0,
-        },
-        two_block: None,
-        structure: Some(StructureRoles {
-            base: "base-slab".into(),
-            floors: vec![roof],
-            joint: "sliding-joint".into(),
-        }),
-    };
-    scene.validate()?;
-    Ok(scene)
+        Vec::new(),
+        vec![roof],
+    )
 }
 
 #[cfg(test)]
