@@ -244,3 +244,61 @@ fn render_writes_a_png_or_names_the_fix() {
         eprintln!("*** no graphics adapter here: {err}");
     }
 }
+
+/// A sweep cut into shards and merged again is the sweep: every grid point once, and a
+/// shard given twice is refused.
+#[test]
+fn sweep_shards_merge_into_the_whole_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = [
+        "--alpha",
+        "0.5",
+        "--friction",
+        "0.1,0.25",
+        "--freq-ratios",
+        "0.5,2",
+        "--duration",
+        "3",
+    ];
+    let mut shards = Vec::new();
+    for i in 1..=3 {
+        let out_dir = dir.path().join(format!("shard-{i}"));
+        let shard = format!("{i}/3");
+        let mut args = vec!["sweep"];
+        args.extend(grid);
+        args.extend(["--shard", &shard, "--out", out_dir.to_str().unwrap()]);
+        let out = slidebase(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        shards.push(out_dir.join("sweep.csv"));
+    }
+    let merged = dir.path().join("merged");
+    let mut args = vec!["merge", "--out", merged.to_str().unwrap()];
+    args.extend(shards.iter().map(|p| p.to_str().unwrap()));
+    let out = slidebase(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows = slidebase::post::sweep::read_sweep_csv(&merged.join("sweep.csv")).unwrap();
+    // 2 models × 1 α × 2 ρ × 2 ratios.
+    assert_eq!(rows.len(), 8);
+    assert!(merged.join("errors.md").exists());
+    let twice = slidebase(&[
+        "merge",
+        "--out",
+        merged.to_str().unwrap(),
+        shards[0].to_str().unwrap(),
+        shards[0].to_str().unwrap(),
+    ]);
+    assert!(!twice.status.success());
+    let err = String::from_utf8_lossy(&twice.stderr);
+    assert!(
+        err.contains("more than one input") && err.lines().count() == 1,
+        "{err}"
+    );
+}

@@ -70,8 +70,8 @@ pub fn write_sweep_csv(path: &Path, rows: &[SweepRow]) -> Result<()> {
 
 /// Reads a sweep CSV; errors name the file and line.
 pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
-    let mut r = csv::Reader::from_path(path)
-        .map_err(|e| Error::Scene(format!("{}: {e}", path.display())))?;
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut r = csv::Reader::from_reader(file);
     let mut rows = Vec::new();
     for rec in r.deserialize::<SweepRow>() {
         let row = rec.map_err(|e| {
