@@ -888,12 +888,14 @@ fn report_markdown(rows: &[StabilityRow]) -> String {
          wall (s) | check | measured |"
     );
     let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---|---|");
+    // Checks and errors may contain '|' (absolute values), which would split the cells.
+    let cell = |text: &str| text.replace('|', "\\|");
     for r in rows {
         let result = match (r.finished, r.passed) {
             (true, true) => "finished ✓".to_string(),
             (true, false) => "finished ✗".to_string(),
-            (false, true) => format!("stopped as it should: {}", r.error),
-            (false, false) => format!("stopped ✗: {}", r.error),
+            (false, true) => format!("stopped as it should: {}", cell(&r.error)),
+            (false, false) => format!("stopped ✗: {}", cell(&r.error)),
         };
         let _ = writeln!(
             s,
@@ -906,8 +908,8 @@ fn report_markdown(rows: &[StabilityRow]) -> String {
             r.passes,
             r.cuts,
             r.wall_time_s,
-            r.check,
-            r.detail
+            cell(&r.check),
+            cell(&r.detail)
         );
     }
     s
