@@ -48,11 +48,18 @@ pub fn point_displacement(c: Point, p: Point, d: &Vec6) -> Point {
 /// that a rotating block keeps its area.
 #[inline]
 pub fn point_displacement_exact_rotation(c: Point, p: Point, d: &Vec6) -> Point {
+    displacement_with_rotation(c, p, d, d[2].sin_cos())
+}
+
+/// Displacement of `p` under `d` with the rotation given by its sine and cosine: the
+/// exact rotation for `d[2].sin_cos()`, the linear map `T·D` for `(d[2], 1)`. Lets a
+/// block compute them once for all its vertices.
+#[inline]
+fn displacement_with_rotation(c: Point, p: Point, d: &Vec6, (sin, cos): (f64, f64)) -> Point {
     let (x, y) = (p[0] - c[0], p[1] - c[1]);
-    let (s, co) = d[2].sin_cos();
     [
-        d[0] + (co - 1.0) * x - s * y + x * d[3] + y * d[5] / 2.0,
-        d[1] + s * x + (co - 1.0) * y + y * d[4] + x * d[5] / 2.0,
+        d[0] + (cos - 1.0) * x - sin * y + x * d[3] + y * d[5] / 2.0,
+        d[1] + sin * x + (cos - 1.0) * y + y * d[4] + x * d[5] / 2.0,
     ]
 }
 
@@ -231,17 +238,13 @@ impl Block {
     pub fn apply_increment(&mut self, d: &Vec6, exact_rotation: bool) -> Result<()> {
         let c = self.moments.centroid;
         // The rotation's sine and cosine once for all vertices.
-        let (sin, cos) = if exact_rotation {
+        let rotation = if exact_rotation {
             d[2].sin_cos()
         } else {
             (d[2], 1.0)
         };
         for p in self.vertices.iter_mut() {
-            let (x, y) = (p[0] - c[0], p[1] - c[1]);
-            let u = [
-                d[0] + (cos - 1.0) * x - sin * y + x * d[3] + y * d[5] / 2.0,
-                d[1] + sin * x + (cos - 1.0) * y + y * d[4] + x * d[5] / 2.0,
-            ];
+            let u = displacement_with_rotation(c, *p, d, rotation);
             p[0] += u[0];
             p[1] += u[1];
         }

@@ -251,9 +251,9 @@ impl BlockMatrix {
         }
     }
 
-    /// ‖K‖∞, the largest absolute row sum.
-    pub fn norm_inf(&self) -> f64 {
-        let mut rows = vec![0.0; self.unknowns()];
+    /// ‖K‖∞, the largest absolute row sum; `rows` (one per unknown) is scratch.
+    pub fn norm_inf(&self, rows: &mut [f64]) -> f64 {
+        rows.iter_mut().for_each(|v| *v = 0.0);
         for (e, &(i, j)) in self.pattern.entries.iter().enumerate() {
             let b = &self.blocks[e];
             for r in 0..6 {
@@ -266,7 +266,7 @@ impl BlockMatrix {
                 }
             }
         }
-        rows.into_iter().fold(0.0, f64::max)
+        rows.iter().copied().fold(0.0, f64::max)
     }
 
     /// Whether every stored value is finite.
@@ -619,16 +619,9 @@ impl LinearSolver {
         self.stats
     }
 
-    /// Forgets the kept factors.
-    pub fn invalidate(&mut self) {
-        for slot in &mut self.slots {
-            slot.factored = None;
-        }
-    }
-
-    /// Solves K x = rhs. `structure` identifies what makes the matrix change by more
-    /// than its slow drift with the geometry (the step size, the scheme, the contact
-    /// states): a kept factor is only tried for a matrix with the same key.
+    /// Solves K x = rhs. `structure` identifies what changes the whole matrix rather
+    /// than drifting it or changing it by a low rank (the step size, the scheme): a kept
+    /// factor is only tried for a matrix with the same key.
     pub fn solve(
         &mut self,
         k: &BlockMatrix,
@@ -673,9 +666,9 @@ impl LinearSolver {
     fn iterate(&mut self, k: &BlockMatrix, rhs: &[f64], x: &mut [f64]) -> bool {
         let norm = |v: &[f64]| v.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
-        let k_norm = k.norm_inf();
         let rhs_norm = norm(rhs);
         let [mut r, mut z, mut p, mut q] = std::mem::take(&mut self.work);
+        let k_norm = k.norm_inf(&mut q);
         // Start from the kept factor's solution.
         x.copy_from_slice(rhs);
         self.apply_inverse(x);

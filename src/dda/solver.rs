@@ -342,7 +342,6 @@ impl Dda {
             time: 0.0,
             reason: format!("cannot analyse the system matrix: {e:?}"),
         })?;
-        let pass_system = Some(System::zeros(Arc::clone(&pattern), 1.0));
         let mut model = Self {
             blocks,
             ground,
@@ -350,7 +349,7 @@ impl Dda {
             dofs,
             pattern,
             linear,
-            pass_system,
+            pass_system: None,
             base_system: None,
             elements: Vec::new(),
             pairs,
