@@ -111,6 +111,11 @@ fn sliding_frame_matches_the_mdof_model() {
     );
     // Isolation: the sliding roof feels a fraction of the ground's peak.
     assert!(dda.peak_roof_accel_g < 0.5 * dda.peak_ground_accel_g);
+    // The friction of a sliding joint starts each step from the extrapolated normal force,
+    // so the open-close iteration settles in about one pass per step (1.02 measured; 1.40
+    // when it started from the force at the step start and needed a pass to correct it).
+    let passes_per_step = dda.open_close_passes as f64 / dda.steps as f64;
+    assert!(passes_per_step < 1.1, "{passes_per_step} passes per step");
     assert!(
         dda.energy_residual_rel.abs() < 0.01,
         "energy residual {}",

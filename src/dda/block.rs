@@ -43,19 +43,24 @@ pub fn point_displacement(c: Point, p: Point, d: &Vec6) -> Point {
     u
 }
 
-/// Displacement of `p` with the rigid rotation taken exactly: the translation and strain
-/// parts are linear, the rotation `r0` is applied as a true rotation about the centroid so
-/// that a rotating block keeps its area.
+/// The sine and cosine that [`displacement_with_rotation`] takes for the increment `d`:
+/// the true rotation's (the translation and strain parts are linear; the rotation `r0` is
+/// applied as a true rotation about the centroid, so that a rotating block keeps its
+/// area), or `(r0, 1)` for the linear map `T·D`.
 #[inline]
-pub fn point_displacement_exact_rotation(c: Point, p: Point, d: &Vec6) -> Point {
-    displacement_with_rotation(c, p, d, d[2].sin_cos())
+pub fn rotation_of(d: &Vec6, exact_rotation: bool) -> (f64, f64) {
+    if exact_rotation {
+        d[2].sin_cos()
+    } else {
+        (d[2], 1.0)
+    }
 }
 
 /// Displacement of `p` under `d` with the rotation given by its sine and cosine: the
 /// exact rotation for `d[2].sin_cos()`, the linear map `T·D` for `(d[2], 1)`. Lets a
 /// block compute them once for all its vertices.
 #[inline]
-fn displacement_with_rotation(c: Point, p: Point, d: &Vec6, (sin, cos): (f64, f64)) -> Point {
+pub fn displacement_with_rotation(c: Point, p: Point, d: &Vec6, (sin, cos): (f64, f64)) -> Point {
     let (x, y) = (p[0] - c[0], p[1] - c[1]);
     [
         d[0] + (cos - 1.0) * x - sin * y + x * d[3] + y * d[5] / 2.0,
@@ -238,11 +243,7 @@ impl Block {
     pub fn apply_increment(&mut self, d: &Vec6, exact_rotation: bool) -> Result<()> {
         let c = self.moments.centroid;
         // The rotation's sine and cosine once for all vertices.
-        let rotation = if exact_rotation {
-            d[2].sin_cos()
-        } else {
-            (d[2], 1.0)
-        };
+        let rotation = rotation_of(d, exact_rotation);
         for p in self.vertices.iter_mut() {
             let u = displacement_with_rotation(c, *p, d, rotation);
             p[0] += u[0];

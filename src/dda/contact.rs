@@ -64,6 +64,9 @@ pub struct ContactMemory {
     pub shear: f64,
     /// Normal force at the end of the last step, N.
     pub normal_force: f64,
+    /// How much the normal force changed over the last step, N: extrapolated, it predicts
+    /// this step's normal force for the friction of the first open-close pass.
+    pub normal_change: f64,
 }
 
 /// A contact during one step: geometry linearised at the step start plus its trial state.
@@ -98,6 +101,10 @@ pub struct Contact {
     pub flips: u32,
     /// Normal force used for friction in the current pass, N.
     pub friction_normal: f64,
+    /// Normal force at the step start (from the contact memory), N.
+    pub start_normal: f64,
+    /// Change of the normal force over the previous step, N (0 for a new contact).
+    pub previous_normal_change: f64,
     /// Tangential slip velocity (vertex relative to edge) at the step start, m/s.
     pub start_slip_velocity: f64,
     /// Tangential slip velocity at the end of the last trial solution, m/s.
@@ -348,15 +355,20 @@ fn linearise(
     let slip_i = t_transpose_times(ci, p1, t);
     let tq = t_transpose_times(cj, q, t);
     let slip_j = tq.map(|v| -v);
-    let (start_state, shear0, normal) = match mem {
+    let (start_state, shear0, normal, normal_change) = match mem {
         // The shear spring is elastic-perfectly-plastic: while sliding it stays stretched
         // at its yield value (force ρN), so a contact that stops picks up the friction
         // force continuously instead of dropping it to zero and ringing.
-        Some(m) => (m.state, m.shear, m.normal_force),
+        Some(m) => (m.state, m.shear, m.normal_force, m.normal_change),
         // Touching or overlapping when first seen: closed and stuck (blocks placed on each
         // other start in contact); otherwise open.
-        None if gap0 <= 0.0 => (ContactState::Locked, 0.0, props.normal_penalty * (-gap0)),
-        None => (ContactState::Open, 0.0, 0.0),
+        None if gap0 <= 0.0 => (
+            ContactState::Locked,
+            0.0,
+            props.normal_penalty * (-gap0),
+            0.0,
+        ),
+        None => (ContactState::Open, 0.0, 0.0, 0.0),
     };
     let start_state = if props.bonded {
         ContactState::Locked
@@ -377,6 +389,8 @@ fn linearise(
         shear0,
         state: start_state,
         friction_normal: normal,
+        start_normal: normal,
+        previous_normal_change: normal_change,
         damping_mass: {
             use super::block::BlockRole::Free;
             let (mi, mj) = (vblock.total_mass(), eblock.total_mass());

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::assembly::{DofMap, System};
 use super::block::{
-    Block, BlockRole, Vec6, point_displacement, point_displacement_exact_rotation,
+    Block, BlockRole, Vec6, displacement_with_rotation, point_displacement, rotation_of,
     t_transpose_times,
 };
 use super::contact::{
@@ -109,16 +109,14 @@ enum Mode {
 struct StepMotion<'a> {
     centroids: &'a [Point],
     increments: &'a [Vec6],
-    exact_rotation: bool,
+    /// Each block's rotation as (sine, cosine): the exact rotation's, or `(r0, 1)` for
+    /// the linear map. Computed once per block, not per node (a frame has ~150 nodes).
+    rotations: &'a [(f64, f64)],
 }
 
 impl NodeMotion for StepMotion<'_> {
     fn node_displacement(&self, b: usize, x: Point) -> Point {
-        if self.exact_rotation {
-            point_displacement_exact_rotation(self.centroids[b], x, &self.increments[b])
-        } else {
-            point_displacement(self.centroids[b], x, &self.increments[b])
-        }
+        displacement_with_rotation(self.centroids[b], x, &self.increments[b], self.rotations[b])
     }
 }
 
@@ -397,6 +395,25 @@ impl Dda {
             self.search_distance,
             &mut self.contacts,
         );
+    }
+
+    /// Starts the friction of each closed contact from its normal force extrapolated over
+    /// this step of `dt` (rather than the force at the step start): the open-close
+    /// iteration repeats a pass until the friction force uses the normal force the pass
+    /// finds, and a sliding frame's normal forces change by more than that tolerance
+    /// (1e-4) in most steps. The prediction is O(Δt²) close and saves the extra pass
+    /// (three-storey frame on El Centro: 1.40 passes per step before, 1.02 with it).
+    fn predict_friction_normals(&mut self, dt: f64) {
+        let previous_dt = self.last.dt;
+        if previous_dt <= 0.0 {
+            return;
+        }
+        for c in &mut self.contacts {
+            if c.start_state.is_closed() {
+                c.friction_normal =
+                    (c.start_normal + c.previous_normal_change * dt / previous_dt).max(0.0);
+            }
+        }
     }
 
     /// Refuses a scene whose blocks overlap at the start by more than a rounding error of
@@ -1078,10 +1095,14 @@ impl Dda {
     /// Moves blocks and joints by the increments and updates the contact memory.
     fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
         let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let rotations: Vec<(f64, f64)> = increments
+            .iter()
+            .map(|d| rotation_of(d, self.params.exact_rotation))
+            .collect();
         let motion = StepMotion {
             centroids: &centroids,
             increments,
-            exact_rotation: self.params.exact_rotation,
+            rotations: &rotations,
         };
         for b in &mut self.bolts {
             b.commit(&motion);
@@ -1113,6 +1134,11 @@ impl Dda {
                     state: c.state,
                     shear,
                     normal_force: c.props.normal_penalty * (-gap).max(0.0),
+                    normal_change: if c.start_state.is_closed() && c.state.is_closed() {
+                        c.props.normal_penalty * (-gap).max(0.0) - c.start_normal
+                    } else {
+                        0.0
+                    },
                 },
             );
         }
@@ -1218,6 +1244,7 @@ impl Dda {
             let mode = Mode::Dynamic { dt };
             let known = self.known_increments(mode);
             self.detect_contacts();
+            self.predict_friction_normals(dt);
             let outcome = self.iterate(mode, &known)?;
             // Land the step on a stick-slip (or impact) event: a transition assumed at the
             // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
