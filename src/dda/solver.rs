@@ -1128,14 +1128,15 @@ impl Dda {
             let gap = c.gap_end(di, dj);
             let shear =
                 yield_stretch(c, c.state, gap).unwrap_or(c.shear0 + c.slip_increment(di, dj));
+            let normal_force = c.props.normal_penalty * (-gap).max(0.0);
             self.memory.insert(
                 c.key,
                 ContactMemory {
                     state: c.state,
                     shear,
-                    normal_force: c.props.normal_penalty * (-gap).max(0.0),
+                    normal_force,
                     normal_change: if c.start_state.is_closed() && c.state.is_closed() {
-                        c.props.normal_penalty * (-gap).max(0.0) - c.start_normal
+                        normal_force - c.start_normal
                     } else {
                         0.0
                     },

@@ -213,13 +213,11 @@ fn errors_against(run: &TwoBlockRun, reference: &TwoBlockRun) -> [f64; 3] {
     ]
 }
 
-/// DDA against the exact model on slip, drift and roof acceleration, within `tol`.
-fn against_exact(
-    case: &str,
-    req: RunRequest,
-    tol: f64,
-    adjust: impl FnOnce(&mut Scene),
-) -> StabilityRow {
+/// The base two-block case with `set` applied to its request: DDA against the exact
+/// model on slip, drift and roof acceleration, within `tol`.
+fn against_exact(case: &str, tol: f64, set: impl FnOnce(&mut RunRequest)) -> StabilityRow {
+    let mut req = base_req();
+    set(&mut req);
     let check = format!(
         "peak slip, drift and roof acceleration within {} % of the exact mass-spring model",
         100.0 * tol
@@ -228,7 +226,7 @@ fn against_exact(
         Ok(r) => r,
         Err(e) => return stopped(case, &check, &e, false),
     };
-    match two_block_run(&req, SolverParams::default(), adjust) {
+    match two_block_run(&req, SolverParams::default(), |_| {}) {
         Ok((run, _)) => {
             let e = errors_against(&run, &reference);
             let worst = e.iter().copied().fold(0.0, f64::max);
@@ -786,43 +784,25 @@ pub fn cases() -> Vec<StabilityCase> {
         case("penalty 1e6 × E", |n| penalty_case(n, 1e6)),
         case("friction 0", friction_zero),
         case("friction 1e-6", |n| {
-            let req = RunRequest {
-                friction: 1e-6,
-                ..base_req()
-            };
-            against_exact(n, req, 0.05, |_| {})
+            against_exact(n, 0.05, |r| r.friction = 1e-6)
         }),
         case("friction 10 (never slides)", friction_ten),
         case("α = 0.001", |n| {
-            let req = RunRequest {
-                alpha: 0.001,
-                ..base_req()
-            };
-            against_exact(n, req, 0.02, |_| {})
+            against_exact(n, 0.02, |r| r.alpha = 0.001)
         }),
         case("α = 0.999", |n| {
-            let req = RunRequest {
-                alpha: 0.999,
-                ..base_req()
-            };
-            against_exact(n, req, 0.02, |_| {})
+            against_exact(n, 0.02, |r| r.alpha = 0.999)
         }),
         case("Ω/ω = 10 with Δt = 0.02", coarse_step),
         case("amplitude 0.001 g", tiny_amplitude),
         case("amplitude 3 g", |n| {
-            let req = RunRequest {
-                amplitude_g: 3.0,
-                ..base_req()
-            };
-            against_exact(n, req, 0.02, |_| {})
+            against_exact(n, 0.02, |r| r.amplitude_g = 3.0)
         }),
         case("Pacoima Dam 1.2 g record", |n| {
-            let req = RunRequest {
-                record: Some("pacoima-dam-164".into()),
-                duration: None,
-                ..base_req()
-            };
-            against_exact(n, req, 0.03, |_| {})
+            against_exact(n, 0.03, |r| {
+                r.record = Some("pacoima-dam-164".into());
+                r.duration = None;
+            })
         }),
         case("structure 1e4 × stiffer, Δt = 0.01", stiff_structure),
         case("density × 1e-4", |n| density_case(n, 1e-4)),
