@@ -190,3 +190,59 @@ force = [0.0, 0.0]
         blk.rotation
     );
 }
+
+/// A box dropped 5 mm onto the ground: with the joint's default `locate_events`, the step
+/// in which it lands is shortened to the impact; with `locate_events = false` every step
+/// keeps the nominal Δt (the impact is taken at the step end, as in classic DDA) and the
+/// box still comes to rest on the ground. This is the switch the generated wall uses for
+/// its internal joints.
+#[test]
+fn a_joint_that_does_not_locate_events_never_shortens_a_step() {
+    let scene_text = |locate: bool| {
+        format!(
+            r#"
+name = "drop"
+[[block]]
+name = "ground"
+vertices = [[-10.0, -1.0], [10.0, -1.0], [10.0, 0.0], [-10.0, 0.0]]
+material = {{ density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }}
+[[block]]
+name = "box"
+vertices = [[-0.5, 0.005], [0.5, 0.005], [0.5, 1.005], [-0.5, 1.005]]
+material = {{ density = 2500.0, youngs_modulus = 3.0e10, poisson_ratio = 0.2 }}
+[ground]
+block = "ground"
+[[contact]]
+blocks = ["box", "ground"]
+friction = 0.6
+locate_events = {locate}
+"#
+        )
+    };
+    let dt = 1e-3;
+    for locate in [true, false] {
+        let scene = Scene::from_toml(&scene_text(locate), "drop").unwrap();
+        let params = SolverParams {
+            dt,
+            duration: 0.3,
+            initial_equilibrium: false,
+            ..SolverParams::default()
+        };
+        let mut dda = Dda::new(&scene, None, params).unwrap();
+        let b = dda.block_index("box").unwrap();
+        let mut shortest = f64::INFINITY;
+        dda.run_until(0.3, |_, r| shortest = shortest.min(r.dt)).unwrap();
+        if locate {
+            assert!(shortest < 0.99 * dt, "no step landed on the impact");
+        } else {
+            assert!(
+                (shortest - dt).abs() < 1e-12 * dt,
+                "a step was shortened to {shortest}"
+            );
+        }
+        // Fallen 5 mm (free fall takes 32 ms) and resting on the ground.
+        let u = dda.blocks()[b].centroid_displacement();
+        assert!((u[1] + 0.005).abs() < 1e-4, "locate {locate}: box at {u:?}");
+        assert!(dda.blocks()[b].velocity[1].abs() < 1e-2, "locate {locate}: still moving");
+    }
+}

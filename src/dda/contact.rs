@@ -43,6 +43,8 @@ pub struct JointProps {
     pub shear_penalty: f64,
     /// Never opens or slides.
     pub bonded: bool,
+    /// Steps land on this joint's events (see `ContactDef::locate_events`).
+    pub locate_events: bool,
 }
 
 /// A declared contact pair between two blocks.
@@ -435,6 +437,7 @@ mod tests {
             normal_penalty: 1.0,
             shear_penalty: 1.0,
             bonded: false,
+            locate_events: true,
         };
         let c = linearise(
             &i,

@@ -286,6 +286,7 @@ impl Dda {
                     normal_penalty: normal,
                     shear_penalty: shear,
                     bonded: c.bonded,
+                    locate_events: c.locate_events,
                 },
             });
         }
@@ -1266,6 +1267,7 @@ impl Dda {
                 let (theta, impact) = self
                     .contacts
                     .iter()
+                    .filter(|c| c.props.locate_events)
                     .map(|c| {
                         let theta = c.event_fraction_in_step();
                         (theta, c.start_state == ContactState::Open && theta < 1.0)
