@@ -231,7 +231,8 @@ locate_events = {locate}
         let mut dda = Dda::new(&scene, None, params).unwrap();
         let b = dda.block_index("box").unwrap();
         let mut shortest = f64::INFINITY;
-        dda.run_until(0.3, |_, r| shortest = shortest.min(r.dt)).unwrap();
+        dda.run_until(0.3, |_, r| shortest = shortest.min(r.dt))
+            .unwrap();
         if locate {
             assert!(shortest < 0.99 * dt, "no step landed on the impact");
         } else {
@@ -243,6 +244,9 @@ locate_events = {locate}
         // Fallen 5 mm (free fall takes 32 ms) and resting on the ground.
         let u = dda.blocks()[b].centroid_displacement();
         assert!((u[1] + 0.005).abs() < 1e-4, "locate {locate}: box at {u:?}");
-        assert!(dda.blocks()[b].velocity[1].abs() < 1e-2, "locate {locate}: still moving");
+        assert!(
+            dda.blocks()[b].velocity[1].abs() < 1e-2,
+            "locate {locate}: still moving"
+        );
     }
 }

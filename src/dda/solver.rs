@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use nalgebra::DVector;
 use serde::Serialize;
+use smallvec::SmallVec;
 
 use super::assembly::{DofMap, System};
 use super::block::{
@@ -22,6 +23,11 @@ use crate::ground_motion::GroundMotion;
 use crate::model::geometry::{self, Point};
 use crate::model::scene::{FixedDirection, GroundKind, Scene};
 use crate::{Error, Result};
+
+/// Per-block values of one step (increments, velocities, centroids), inline for models of
+/// up to four blocks: a two-block step is a few microseconds, and the heap traffic of a
+/// handful of small vectors per step was 5 % of it. Larger models spill to the heap.
+type PerBlock<T> = SmallVec<[T; 4]>;
 
 /// State changes of one contact within one step after which its state is kept.
 const MAX_FLIPS_PER_STEP: u32 = 4;
@@ -542,8 +548,8 @@ impl Dda {
     }
 
     /// Known increments of prescribed blocks for a step from t to t + dt.
-    fn known_increments(&self, mode: Mode) -> Vec<Vec6> {
-        let mut known = vec![[0.0; 6]; self.blocks.len()];
+    fn known_increments(&self, mode: Mode) -> PerBlock<Vec6> {
+        let mut known = PerBlock::from_elem([0.0; 6], self.blocks.len());
         if let (Mode::Dynamic { dt }, GroundKind::Prescribed, Some(m)) =
             (mode, self.ground_kind, &self.motion)
         {
@@ -629,7 +635,7 @@ impl Dda {
                 }
             }
         }
-        let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let centroids: PerBlock<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
         for e in elements {
             sys.add_nodal_element(&self.dofs, known, &centroids, e);
         }
@@ -776,7 +782,7 @@ impl Dda {
 
     /// Runs the open-close iteration. Returns the increments of all blocks and the number
     /// of passes, or `None` if the states did not settle within the allowed passes.
-    fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Option<(Vec<Vec6>, usize)>> {
+    fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Option<(PerBlock<Vec6>, usize)>> {
         let mut elements = std::mem::take(&mut self.elements);
         self.element_terms_into(&mut elements);
         let mut base = self
@@ -796,7 +802,7 @@ impl Dda {
         mode: Mode,
         known: &[Vec6],
         base: &System,
-    ) -> Result<Option<(Vec<Vec6>, usize)>> {
+    ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
         let alpha_f = match mode {
             Mode::Dynamic { .. } => self.coeffs.alpha_f,
             Mode::Static { .. } | Mode::Modal => 0.0,
@@ -810,7 +816,8 @@ impl Dda {
         let open_tolerance = 1e-12 * self.structure_size;
         let slip_tolerance = 1e-12 * self.structure_size;
         let max_passes = self.params.max_open_close_passes;
-        let mut solution = vec![0.0; self.dofs.n];
+        // Inline up to four blocks' unknowns (the tiny-system path of the linear solver).
+        let mut solution: SmallVec<[f64; 24]> = SmallVec::from_elem(0.0, self.dofs.n);
         for pass in 1..=max_passes {
             let mut sys = match self.pass_system.take() {
                 Some(mut sys) => {
@@ -829,7 +836,9 @@ impl Dda {
             let increments = self.increments(&solution, known);
             let velocities = match mode {
                 Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
-                Mode::Static { .. } | Mode::Modal => vec![[0.0; 6]; self.blocks.len()],
+                Mode::Static { .. } | Mode::Modal => {
+                    PerBlock::from_elem([0.0; 6], self.blocks.len())
+                }
             };
             let mut changed = false;
             let mut contradicted = false;
@@ -967,7 +976,7 @@ impl Dda {
 
     /// Velocities at the end of a trial step (Newmark update; the prescribed ground's
     /// from the motion), used to judge slip reversals.
-    fn end_velocities(&self, increments: &[Vec6], dt: f64) -> Vec<Vec6> {
+    fn end_velocities(&self, increments: &[Vec6], dt: f64) -> PerBlock<Vec6> {
         let c = &self.coeffs;
         self.blocks
             .iter()
@@ -996,7 +1005,7 @@ impl Dda {
     }
 
     /// Increments of all blocks from the solution vector and the known ones.
-    fn increments(&self, solution: &[f64], known: &[Vec6]) -> Vec<Vec6> {
+    fn increments(&self, solution: &[f64], known: &[Vec6]) -> PerBlock<Vec6> {
         (0..self.blocks.len())
             .map(|b| match self.dofs.slot[b] {
                 Some(s) => {
@@ -1077,6 +1086,7 @@ impl Dda {
     /// and that displacement as a fraction of the structure size.
     fn most_displaced_block(&self, increments: &[Vec6]) -> (usize, f64) {
         let g = increments[self.ground];
+        // Squared lengths compared, one square root at the end (this runs every step).
         let mut max = (self.ground, 0.0_f64);
         for (bi, b) in self.blocks.iter().enumerate() {
             if bi == self.ground {
@@ -1084,19 +1094,20 @@ impl Dda {
             }
             for &p in &b.vertices {
                 let u = point_displacement(b.moments.centroid, p, &increments[bi]);
-                let d = (u[0] - g[0]).hypot(u[1] - g[1]);
-                if d > max.1 {
-                    max = (bi, d);
+                let (dx, dy) = (u[0] - g[0], u[1] - g[1]);
+                let d2 = dx * dx + dy * dy;
+                if d2 > max.1 {
+                    max = (bi, d2);
                 }
             }
         }
-        (max.0, max.1 / self.structure_size)
+        (max.0, max.1.sqrt() / self.structure_size)
     }
 
     /// Moves blocks and joints by the increments and updates the contact memory.
     fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
-        let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
-        let rotations: Vec<(f64, f64)> = increments
+        let centroids: PerBlock<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let rotations: PerBlock<(f64, f64)> = increments
             .iter()
             .map(|d| rotation_of(d, self.params.exact_rotation))
             .collect();
@@ -1370,7 +1381,7 @@ impl Dda {
         let residual_before = self.energy.residual();
         let c = self.coeffs;
         let t_new = self.time + dt;
-        let start_velocities: Vec<Vec6> = self.blocks.iter().map(|b| b.velocity).collect();
+        let start_velocities: PerBlock<Vec6> = self.blocks.iter().map(|b| b.velocity).collect();
         // Newmark update of velocities and accelerations.
         for (bi, b) in self.blocks.iter_mut().enumerate() {
             match b.role {
@@ -1466,7 +1477,7 @@ impl Dda {
             }
         }
         // Joints that tie the structure to the ground.
-        let centroids: Vec<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let centroids: PerBlock<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
         let ground_elements: Vec<ElementTerms> = self
             .bolts
             .iter()
