@@ -19,7 +19,7 @@ use super::two_block::ModelKind;
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, resolve_record};
 use crate::model::presets::resolve_scene;
-use crate::post::plot::{Figure, Series};
+use crate::post::plot::{Figure, LegendCorner, Series};
 use crate::{Error, Result};
 
 /// What to measure.
@@ -483,6 +483,8 @@ pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
     p.y_label = "wall time per step (ms)".into();
     p.x_log = true;
     p.y_log = true;
+    // The cost rises to the right: the top-left corner is empty.
+    p.legend = LegendCorner::UpperLeft;
     for (k, family) in ["frame", "wall"].iter().enumerate() {
         let pts: Vec<&ScalingPoint> = r.scaling.iter().filter(|p| p.family == *family).collect();
         if pts.is_empty() {

@@ -115,6 +115,18 @@ pub struct Panel {
     pub hlines: Vec<f64>,
     /// Short notes written in the panel's top-left corner.
     pub notes: Vec<String>,
+    /// Where the legend goes: it should cover the corner the data leave empty.
+    pub legend: LegendCorner,
+}
+
+/// A corner of a panel, for its legend.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum LegendCorner {
+    /// Top right (the default: most responses decay or stay level).
+    #[default]
+    UpperRight,
+    /// Top left (for data that rise to the right, like cost against size).
+    UpperLeft,
 }
 
 /// A figure: a title and a grid of panels.
@@ -328,7 +340,10 @@ fn draw_panel<DB: DrawingBackend>(
     if any_label {
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(match p.legend {
+                LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+                LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+            })
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(180, 180, 180))
             .label_font((FONT, 12).into_font())
