@@ -26,7 +26,7 @@ use crate::{Error, Result};
 
 /// Per-block values of one step (increments, velocities, centroids), inline for models of
 /// up to four blocks: a two-block step is a few microseconds, and the heap traffic of a
-/// handful of small vectors per step was 5 % of it. Larger models spill to the heap.
+/// handful of small vectors per step was 4 % of it. Larger models spill to the heap.
 type PerBlock<T> = SmallVec<[T; 4]>;
 
 /// State changes of one contact within one step after which its state is kept.
