@@ -196,13 +196,15 @@ fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// `sin(ωx)/ω`, with its limit `x` for a rigid mode.
+/// `(sin(ωx)/ω, cos(ωx))`, with the limits `(x, 1)` for a rigid mode (ω = 0), which
+/// needs no trigonometry.
 #[inline]
-fn sin_over(omega: f64, x: f64) -> f64 {
+fn sin_cos_over(omega: f64, x: f64) -> (f64, f64) {
     if omega == 0.0 {
-        x
+        (x, 1.0)
     } else {
-        (omega * x).sin() / omega
+        let (sin, cos) = (omega * x).sin_cos();
+        (sin / omega, cos)
     }
 }
 
@@ -278,17 +280,11 @@ impl Solver<'_> {
             let mut conv_d = 0.0;
             for &(s, wt, a) in nodes {
                 let f = sys.beta[j] * a + delta * sys.gamma[j];
-                // sin(ω(τ − s))/ω and cos(ω(τ − s)); a rigid mode (ω = 0) needs no trigonometry.
-                let (sin_over_w, cos) = if w == 0.0 {
-                    (tau - s, 1.0)
-                } else {
-                    let (sn, cs) = (w * (tau - s)).sin_cos();
-                    (sn / w, cs)
-                };
+                let (sin_over_w, cos) = sin_cos_over(w, tau - s);
                 conv += wt * sin_over_w * f;
                 conv_d += wt * cos * f;
             }
-            q[j] = q0[j] * cs + qd0[j] * sin_over(w, tau) + conv;
+            q[j] = q0[j] * cs + qd0[j] * sin_cos_over(w, tau).0 + conv;
             qd[j] = -q0[j] * w * sn + qd0[j] * cs + conv_d;
         }
         let x = times(&sys.modal.phi, &q);

@@ -10,10 +10,10 @@ use std::sync::Arc;
 
 use nalgebra::DVector;
 
-use super::block::{Mat6, Vec6};
+use super::block::{Mat6, Vec6, t_transpose_at};
 use super::joints::ElementTerms;
 use super::linear::{BlockMatrix, BlockPattern};
-use crate::model::geometry::Point;
+use crate::model::geometry::{self, Point};
 
 /// Maps blocks to unknowns and holds the known increments of prescribed blocks.
 #[derive(Debug, Clone)]
@@ -145,11 +145,10 @@ impl System {
         let n = nodes.len();
         let dim = 2 * n;
         let c = self.stiffness_factor;
-        // Node offsets from their blocks' centroids: T of a node (block::t_matrix) is
-        // half zeros and ones, so Tᵀ·v is formed from the offset directly.
+        // Node offsets from their blocks' centroids: Tᵀ·v is formed from them directly.
         let mut offsets = [[0.0; 2]; 3];
         for (o, &(b, x)) in offsets.iter_mut().zip(nodes) {
-            *o = [x[0] - centroids[b][0], x[1] - centroids[b][1]];
+            *o = geometry::sub(x, centroids[b]);
         }
         // The distinct blocks of the nodes, and which of them carries each node.
         let mut blocks = [0usize; 3];
@@ -173,7 +172,7 @@ impl System {
                 let skg = &mut s[k][group[l]];
                 for r in 0..2 {
                     let row = (2 * k + r) * dim + 2 * l;
-                    let t = t_transpose_apply(offsets[l], ke[row], ke[row + 1]);
+                    let t = t_transpose_at(offsets[l], [ke[row], ke[row + 1]]);
                     for j in 0..6 {
                         skg[r][j] += t[j];
                     }
@@ -186,7 +185,7 @@ impl System {
             };
             // Start-of-step force.
             for k in (0..n).filter(|&k| group[k] == gp) {
-                let f = t_transpose_apply(offsets[k], fe[2 * k], fe[2 * k + 1]);
+                let f = t_transpose_at(offsets[k], [fe[2 * k], fe[2 * k + 1]]);
                 for i in 0..6 {
                     self.r[sp + i] -= f[i];
                 }
@@ -202,7 +201,7 @@ impl System {
                 for k in (0..n).filter(|&k| group[k] == gp) {
                     let skq = &s[k][gq];
                     for j in 0..6 {
-                        let column = t_transpose_apply(offsets[k], skq[0][j], skq[1][j]);
+                        let column = t_transpose_at(offsets[k], [skq[0][j], skq[1][j]]);
                         for i in 0..6 {
                             m[i][j] += column[i];
                         }
@@ -220,24 +219,6 @@ impl System {
             }
         }
     }
-}
-
-/// `T(p)ᵀ (a, b)` for a point at `offset` = p − centroid from its block's centroid: the
-/// rows of [`t_matrix`](super::block::t_matrix) are `[1, 0, −y, x, 0, y/2]` and `[0, 1, x, 0, y, x/2]`, so this
-/// is six products instead of twelve (the same values: the skipped terms are exact
-/// multiplications by one and zero). The frame's connection assembly runs it ~20 times
-/// per element per step.
-#[inline]
-fn t_transpose_apply(offset: Point, a: f64, b: f64) -> Vec6 {
-    let (x, y) = (offset[0], offset[1]);
-    [
-        a,
-        b,
-        -y * a + x * b,
-        x * a,
-        y * b,
-        y / 2.0 * a + x / 2.0 * b,
-    ]
 }
 
 /// Displacement of node `x` of block `b` given all blocks' increments.

@@ -381,7 +381,7 @@ const BACKWARD_ERROR: f64 = 1e-14;
 /// Systems of up to four blocks (24 unknowns) are factorised with nalgebra's Cholesky at
 /// a size fixed at compile time (unrolled, on the stack): at this size the set-up of a
 /// blocked, vectorised factorisation costs more than the arithmetic.
-const TINY_LIMIT: usize = 24;
+pub(crate) const TINY_LIMIT: usize = 24;
 
 /// A Cholesky factor of a compile-time size.
 type TinyCholesky<const N: usize> = Option<nalgebra::Cholesky<f64, nalgebra::Const<N>>>;

@@ -17,7 +17,7 @@ use super::contact::{
 use super::energy::EnergyTerms;
 use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
 use super::judge::{ContactState, JudgeInput, judge};
-use super::linear::{BlockPattern, LinearSolver, SolveError};
+use super::linear::{BlockPattern, LinearSolver, SolveError, TINY_LIMIT};
 use super::params::{AlphaCoefficients, SolverParams};
 use crate::ground_motion::GroundMotion;
 use crate::model::geometry::{self, Point};
@@ -816,8 +816,8 @@ impl Dda {
         let open_tolerance = 1e-12 * self.structure_size;
         let slip_tolerance = 1e-12 * self.structure_size;
         let max_passes = self.params.max_open_close_passes;
-        // Inline up to four blocks' unknowns (the tiny-system path of the linear solver).
-        let mut solution: SmallVec<[f64; 24]> = SmallVec::from_elem(0.0, self.dofs.n);
+        // Inline for the systems the linear solver factorises on the stack.
+        let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
         for pass in 1..=max_passes {
             let mut sys = match self.pass_system.take() {
                 Some(mut sys) => {
