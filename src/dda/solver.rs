@@ -547,6 +547,12 @@ impl Dda {
         b != self.ground
     }
 
+    /// The blocks' centroids at the step start, the origins of their unknowns (a copy,
+    /// so that the blocks can be moved while it is read).
+    fn centroids(&self) -> PerBlock<Point> {
+        self.blocks.iter().map(|b| b.moments.centroid).collect()
+    }
+
     /// Known increments of prescribed blocks for a step from t to t + dt.
     fn known_increments(&self, mode: Mode) -> PerBlock<Vec6> {
         let mut known = PerBlock::from_elem([0.0; 6], self.blocks.len());
@@ -635,7 +641,7 @@ impl Dda {
                 }
             }
         }
-        let centroids: PerBlock<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let centroids = self.centroids();
         for e in elements {
             sys.add_nodal_element(&self.dofs, known, &centroids, e);
         }
@@ -1106,7 +1112,7 @@ impl Dda {
 
     /// Moves blocks and joints by the increments and updates the contact memory.
     fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
-        let centroids: PerBlock<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let centroids = self.centroids();
         let rotations: PerBlock<(f64, f64)> = increments
             .iter()
             .map(|d| rotation_of(d, self.params.exact_rotation))
@@ -1477,7 +1483,7 @@ impl Dda {
             }
         }
         // Joints that tie the structure to the ground.
-        let centroids: PerBlock<Point> = self.blocks.iter().map(|b| b.moments.centroid).collect();
+        let centroids = self.centroids();
         let ground_elements: Vec<ElementTerms> = self
             .bolts
             .iter()
