@@ -84,6 +84,15 @@ impl System {
         self.k.add(s / 6, s / 6, m, scale);
     }
 
+    /// Holds the strain unknowns of the block whose unknowns start at `s` at zero (a
+    /// rigid block, see [`BlockMatrix::hold_strains`]).
+    pub fn hold_strains(&mut self, s: usize) {
+        self.k.hold_strains(s / 6);
+        for i in 3..6 {
+            self.r[s + i] = 0.0;
+        }
+    }
+
     /// Adds `v` to the right-hand side of the unknowns starting at `s`.
     pub fn add_rhs(&mut self, s: usize, v: &Vec6, scale: f64) {
         for i in 0..6 {

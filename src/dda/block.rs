@@ -178,8 +178,11 @@ pub struct Block {
     pub strain: [f64; 3],
     /// Velocity of the 6 unknowns.
     pub velocity: Vec6,
-    /// Acceleration of the 6 unknowns.
+    /// The integrator's acceleration variable of the 6 unknowns (for the generalised-α
+    /// family it is not the acceleration at the step end: see `response_accel`).
     pub accel: Vec6,
+    /// The acceleration at the current time: the one that balances the forces now.
+    pub response_accel: Vec6,
     /// Mass matrix for the current geometry.
     pub mass: Mat6,
     /// Free, prescribed ground or large-mass ground.
@@ -191,6 +194,8 @@ pub struct Block {
     pub reference_centroid: Point,
     /// Accumulated rotation r0 since the reference time, rad.
     pub rotation: f64,
+    /// Rigid: the strain unknowns are held at zero.
+    pub rigid: bool,
 }
 
 impl Block {
@@ -215,8 +220,10 @@ impl Block {
             strain: [0.0; 3],
             velocity: [0.0; 6],
             accel: [0.0; 6],
+            response_accel: [0.0; 6],
             role,
             rotation: 0.0,
+            rigid: false,
         })
     }
 

@@ -69,6 +69,10 @@ pub struct ContactMemory {
     /// How much the normal force changed over the last step, N: extrapolated, it predicts
     /// this step's normal force for the friction of the first open-close pass.
     pub normal_change: f64,
+    /// Augmented Lagrangian: the shear force multiplier (force on the vertex along the
+    /// edge tangent), N; while sliding, the friction force, so that a contact that sticks
+    /// picks it up continuously.
+    pub shear_multiplier: f64,
 }
 
 /// A contact during one step: geometry linearised at the step start plus its trial state.
@@ -114,6 +118,13 @@ pub struct Contact {
     /// Where in the step (fraction 0..1) the state first changed from the start state in
     /// the open-close iteration; 1 when it did not. Used to land steps on stick-slip events.
     pub event_fraction: f64,
+    /// Augmented Lagrangian: normal force multiplier (compressive positive), N, of the
+    /// current iterate.
+    pub normal_multiplier: f64,
+    /// Augmented Lagrangian: shear force multiplier (force on the vertex along t̂), N.
+    pub shear_multiplier: f64,
+    /// The shear multiplier at the step start.
+    pub start_shear_multiplier: f64,
     /// Contact point (P1) and edge tangent at the step start, for drawing and reports.
     pub point: Point,
     /// Edge unit tangent t̂.
@@ -357,11 +368,17 @@ fn linearise(
     let slip_i = t_transpose_times(ci, p1, t);
     let tq = t_transpose_times(cj, q, t);
     let slip_j = tq.map(|v| -v);
-    let (start_state, shear0, normal, normal_change) = match mem {
+    let (start_state, shear0, normal, normal_change, shear_multiplier) = match mem {
         // The shear spring is elastic-perfectly-plastic: while sliding it stays stretched
         // at its yield value (force ρN), so a contact that stops picks up the friction
         // force continuously instead of dropping it to zero and ringing.
-        Some(m) => (m.state, m.shear, m.normal_force, m.normal_change),
+        Some(m) => (
+            m.state,
+            m.shear,
+            m.normal_force,
+            m.normal_change,
+            m.shear_multiplier,
+        ),
         // Touching or overlapping when first seen: closed and stuck (blocks placed on each
         // other start in contact); otherwise open.
         None if gap0 <= 0.0 => (
@@ -369,8 +386,9 @@ fn linearise(
             0.0,
             props.normal_penalty * (-gap0),
             0.0,
+            0.0,
         ),
-        None => (ContactState::Open, 0.0, 0.0, 0.0),
+        None => (ContactState::Open, 0.0, 0.0, 0.0, 0.0),
     };
     let start_state = if props.bonded {
         ContactState::Locked
@@ -406,6 +424,9 @@ fn linearise(
         start_slip_velocity,
         end_slip_velocity: start_slip_velocity,
         event_fraction: 1.0,
+        normal_multiplier: normal,
+        shear_multiplier,
+        start_shear_multiplier: shear_multiplier,
         point: p1,
         tangent: t,
     }

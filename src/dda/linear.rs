@@ -218,6 +218,31 @@ impl BlockMatrix {
         }
     }
 
+    /// Holds the strain unknowns (3..6) of block `bi` at zero: their rows and columns are
+    /// cleared and their diagonal set to one, so that with a zero right-hand side they
+    /// solve to zero exactly — the restriction of the system to a rigid block's three
+    /// rigid-body unknowns, without a stiff (and ringing) mode in their place.
+    pub fn hold_strains(&mut self, bi: usize) {
+        for (e, &(i, j)) in self.pattern.entries.iter().enumerate() {
+            let b = &mut self.blocks[e];
+            if i == bi {
+                for row in b.iter_mut().skip(3) {
+                    *row = [0.0; 6];
+                }
+            }
+            if j == bi {
+                for row in b.iter_mut() {
+                    row[3..].fill(0.0);
+                }
+            }
+            if i == bi && j == bi {
+                for k in 3..6 {
+                    b[k][k] = 1.0;
+                }
+            }
+        }
+    }
+
     /// The diagonal block of block `bi`, for in-place updates.
     #[inline]
     pub fn diagonal_mut(&mut self, bi: usize) -> &mut Mat6 {

@@ -18,5 +18,5 @@ pub mod params;
 pub mod solver;
 
 pub use energy::EnergyTerms;
-pub use params::{Integrator, SolverParams};
+pub use params::{ContactEnforcement, Integrator, SolverParams};
 pub use solver::{Dda, Modes, RunCounters, StepReport};

@@ -157,6 +157,21 @@ impl Integrator {
     }
 }
 
+/// How closed contacts carry their forces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum ContactEnforcement {
+    /// Shi's penalty springs: a closed contact is a stiff spring, so a stuck joint is an
+    /// oscillator (kHz) whose ringing at every re-stick equals the jump of the acceleration.
+    Penalty,
+    /// Augmented Lagrangian: the penalty springs only regularise the solve; multipliers
+    /// carry the contact forces, iterated until the constraint (no penetration, no slip
+    /// while stuck) holds to [`SolverParams::constraint_tolerance`]. A stuck joint is then
+    /// exactly stuck.
+    #[default]
+    AugmentedLagrangian,
+}
+
 /// Everything that controls the DDA solver (not the physics of the scene).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -197,6 +212,11 @@ pub struct SolverParams {
     /// Update vertices with the exact rotation (cos r − 1, sin r) instead of the linear
     /// map, which inflates areas by (1 + r²) per step under rotation.
     pub exact_rotation: bool,
+    /// How closed contacts carry their forces.
+    pub contact_enforcement: ContactEnforcement,
+    /// Augmented Lagrangian: iterate until every closed contact's constraint violation,
+    /// times its penalty, is below this fraction of the largest contact force.
+    pub constraint_tolerance: f64,
 }
 
 impl Default for SolverParams {
@@ -215,6 +235,8 @@ impl Default for SolverParams {
             restart_after_events: true,
             contact_damping: 0.0,
             exact_rotation: true,
+            contact_enforcement: ContactEnforcement::default(),
+            constraint_tolerance: 1e-10,
         }
     }
 }

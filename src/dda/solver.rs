@@ -94,6 +94,8 @@ pub struct RunCounters {
     pub factorizations: u64,
     /// Conjugate-gradient iterations with a kept factor.
     pub cg_iterations: u64,
+    /// Augmented-Lagrangian solves (one per multiplier update).
+    pub constraint_iterations: u64,
 }
 
 /// Which linear problem an iteration solves.
@@ -167,6 +169,34 @@ pub struct Dda {
     restart: Restart,
     /// When the last step was landed on an event.
     last_landing: f64,
+    /// The states contacts take at the event a shortened step is landed on.
+    pending_events: Vec<(contact::ContactKey, ContactState)>,
+}
+
+/// Which state of the blocks a projection acts on.
+#[derive(Clone, Copy)]
+enum Field {
+    Velocity,
+    Accel,
+    Response,
+}
+
+impl Field {
+    fn of(self, b: &Block) -> Vec6 {
+        match self {
+            Field::Velocity => b.velocity,
+            Field::Accel => b.accel,
+            Field::Response => b.response_accel,
+        }
+    }
+
+    fn of_mut(self, b: &mut Block) -> &mut Vec6 {
+        match self {
+            Field::Velocity => &mut b.velocity,
+            Field::Accel => &mut b.accel,
+            Field::Response => &mut b.response_accel,
+        }
+    }
 }
 
 /// How a step restarts the time integrator after a contact event.
@@ -213,7 +243,9 @@ impl Dda {
                 (true, GroundKind::Prescribed) => BlockRole::PrescribedGround,
                 (true, GroundKind::LargeMass) => BlockRole::LargeMassGround,
             };
-            blocks.push(Block::new(&b.name, b.vertices.clone(), b.material, role)?);
+            let mut block = Block::new(&b.name, b.vertices.clone(), b.material, role)?;
+            block.rigid = b.rigid;
+            blocks.push(block);
         }
         let structure: Vec<Point> = blocks
             .iter()
@@ -379,6 +411,7 @@ impl Dda {
             last: StepReport::default(),
             restart: Restart::None,
             last_landing: f64::NEG_INFINITY,
+            pending_events: Vec::new(),
         };
         model.check_initial_overlap()?;
         if model.params.initial_equilibrium {
@@ -402,6 +435,32 @@ impl Dda {
             self.search_distance,
             &mut self.contacts,
         );
+        if self.augmented() {
+            self.scale_constraint_penalties();
+        }
+    }
+
+    /// With the augmented Lagrangian the penalties only set how fast the multipliers
+    /// converge: each iteration shrinks the constraint violation by about k/(k + p), k
+    /// the stiffness the contact sees (inertia M/(βΔt²) or block elasticity). They are
+    /// raised to a hundred times that, so that a few iterations reach round-off, yet
+    /// not so far that the factorisation loses the soft directions (1e-16 · p/k).
+    fn scale_constraint_penalties(&mut self) {
+        const FACTOR: f64 = 100.0;
+        let mass_factor = 1.0 / (self.coeffs.beta * self.params.dt * self.params.dt);
+        let stiffness = |b: &Block| {
+            if b.role == BlockRole::PrescribedGround {
+                0.0
+            } else {
+                (mass_factor * b.total_mass()).max(b.material.youngs_modulus)
+            }
+        };
+        for c in &mut self.contacts {
+            let k = stiffness(&self.blocks[c.key.vertex_block])
+                .max(stiffness(&self.blocks[c.key.edge_block]));
+            c.props.normal_penalty = c.props.normal_penalty.max(FACTOR * k);
+            c.props.shear_penalty = c.props.normal_penalty;
+        }
     }
 
     /// Starts the friction of each closed contact from its normal force extrapolated over
@@ -537,10 +596,24 @@ impl Dda {
             b.rotation = 0.0;
             b.velocity = [0.0; 6];
             b.accel = [0.0; 6];
+            b.response_accel = [0.0; 6];
         }
         self.energy = EnergyTerms::default();
         self.stored_reference = self.stored_energy();
         self.energy_scale = 0.0;
+    }
+
+    /// Holds the strain unknowns of rigid blocks at zero in `sys`.
+    fn hold_rigid_strains(&self, sys: &mut System) {
+        for (b, slot) in self.blocks.iter().zip(&self.dofs.slot) {
+            if let (true, Some(s)) = (b.rigid, *slot) {
+                sys.hold_strains(s);
+            }
+        }
+    }
+
+    fn augmented(&self) -> bool {
+        self.params.contact_enforcement == super::params::ContactEnforcement::AugmentedLagrangian
     }
 
     fn is_structure(&self, b: usize) -> bool {
@@ -555,13 +628,11 @@ impl Dda {
 
     /// Known increments of prescribed blocks for a step from t to t + dt.
     fn known_increments(&self, mode: Mode) -> PerBlock<Vec6> {
-        let mut known = PerBlock::from_elem([0.0; 6], self.blocks.len());
-        if let (Mode::Dynamic { dt }, GroundKind::Prescribed, Some(m)) =
-            (mode, self.ground_kind, &self.motion)
-        {
-            known[self.ground][0] = m.displacement(self.time + dt) - m.displacement(self.time);
-        }
-        known
+        // The model moves with the ground (see `frame_offset`): a prescribed ground
+        // stands still in it, and the ground's acceleration acts on every block as a body
+        // force instead.
+        let _ = mode;
+        PerBlock::from_elem([0.0; 6], self.blocks.len())
     }
 
     fn element_terms(&self) -> Vec<ElementTerms> {
@@ -634,10 +705,11 @@ impl Dda {
                     let mw: f64 = (0..6).map(|j| b.mass[i][j] * w[j]).sum();
                     sys.r[s + i] -= mw;
                 }
-                if b.role == BlockRole::LargeMassGround {
-                    // Paper eq. (4): f = m_g ü0, at the generalised-α time point.
+                // The frame moves with the ground: every block feels −m ü0. The paper's
+                // large-mass ground is driven by f = m_g ü0 (eq. 4), which cancels it.
+                if b.role != BlockRole::LargeMassGround {
                     let t_alpha = self.time + (1.0 - c.alpha_f) * dt;
-                    sys.r[s] += b.total_mass() * self.ground_accel(t_alpha);
+                    sys.r[s] -= b.total_mass() * self.ground_accel(t_alpha);
                 }
             }
         }
@@ -660,6 +732,13 @@ impl Dda {
                 self.add_dashpots(sys, c, dt);
             }
             let (i, j) = (c.key.vertex_block, c.key.edge_block);
+            // Augmented Lagrangian: the multipliers carry the force, the springs only
+            // pull the iterate onto the constraint (energy ½p g² − λ g).
+            let (lambda_n, lambda_s) = if self.augmented() {
+                (c.normal_multiplier, c.shear_multiplier)
+            } else {
+                (0.0, 0.0)
+            };
             match c.state {
                 ContactState::Open => {}
                 ContactState::Locked => {
@@ -668,7 +747,7 @@ impl Dda {
                         &self.dofs,
                         known,
                         p,
-                        p * c.gap0,
+                        p * c.gap0 - lambda_n,
                         (i, &c.gap_i),
                         Some((j, &c.gap_j)),
                     );
@@ -677,7 +756,7 @@ impl Dda {
                         &self.dofs,
                         known,
                         ps,
-                        ps * c.shear0,
+                        ps * c.shear0 - lambda_s,
                         (i, &c.slip_i),
                         Some((j, &c.slip_j)),
                     );
@@ -688,7 +767,7 @@ impl Dda {
                         &self.dofs,
                         known,
                         p,
-                        p * c.gap0,
+                        p * c.gap0 - lambda_n,
                         (i, &c.gap_i),
                         Some((j, &c.gap_j)),
                     );
@@ -765,14 +844,8 @@ impl Dda {
                                 + co.alpha_f * dot6(vec, &bl.velocity));
                         parts.push((blk, vec));
                     }
-                    None => {
-                        let v1 = self
-                            .motion
-                            .as_ref()
-                            .map_or(0.0, |m| m.velocity(self.time + dt));
-                        let v_alpha = (1.0 - co.alpha_f) * v1 + co.alpha_f * bl.velocity[0];
-                        f0 += damping * vec[0] * v_alpha;
-                    }
+                    // The prescribed ground stands still in the moving frame.
+                    None => {}
                 }
             }
             let k = damping * co.gamma / (co.beta * dt);
@@ -825,27 +898,14 @@ impl Dda {
         // Inline for the systems the linear solver factorises on the stack.
         let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
         for pass in 1..=max_passes {
-            let mut sys = match self.pass_system.take() {
-                Some(mut sys) => {
-                    sys.copy_from(base);
-                    sys
-                }
-                None => base.clone(),
-            };
-            self.add_contacts(&mut sys, known, mode);
-            let structure = self.structure_key(mode);
-            let solved = self
-                .linear
-                .solve(&sys.k, sys.r.as_slice(), structure, &mut solution);
-            self.pass_system = Some(sys);
-            solved.map_err(|e| self.solve_error(e))?;
-            let increments = self.increments(&solution, known);
+            let increments = self.solve_pass(mode, known, base, &mut solution)?;
             let velocities = match mode {
                 Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
                 Mode::Static { .. } | Mode::Modal => {
                     PerBlock::from_elem([0.0; 6], self.blocks.len())
                 }
             };
+            let augmented = self.augmented();
             let mut changed = false;
             let mut contradicted = false;
             let mut max_normal = 0.0_f64;
@@ -859,12 +919,33 @@ impl Dda {
                 let slip = c.slip_increment(di, dj);
                 let slip_velocity = dot6(&c.slip_i, &velocities[c.key.vertex_block])
                     + dot6(&c.slip_j, &velocities[c.key.edge_block]);
-                let normal_force = c.props.normal_penalty * (-gap).max(0.0);
+                // The forces the judge weighs: the springs' (penalty) or the multipliers'
+                // (augmented Lagrangian, where a closed contact's gap is held at zero and
+                // its force says whether it would rather open: the penalty-equivalent
+                // gap −λ/p).
+                let p = c.props.normal_penalty;
+                let ps = c.props.shear_penalty;
+                let (judged_gap, normal_force, shear_start, shear_force) =
+                    if augmented && c.state.is_closed() {
+                        (
+                            -c.normal_multiplier / p,
+                            c.normal_multiplier.max(0.0),
+                            -c.start_shear_multiplier,
+                            -c.shear_multiplier,
+                        )
+                    } else {
+                        (
+                            gap,
+                            p * (-gap).max(0.0),
+                            ps * c.shear0,
+                            ps * (c.shear0 + slip),
+                        )
+                    };
                 c.end_slip_velocity = slip_velocity;
                 let new_state = judge(&JudgeInput {
                     state: c.state,
-                    gap,
-                    shear_force: c.props.shear_penalty * (c.shear0 + slip),
+                    gap: judged_gap,
+                    shear_force,
                     normal_force,
                     // The static settle holds every joint stuck: it finds the preload of
                     // the normal springs; whether friction can hold the blocks is decided
@@ -881,8 +962,12 @@ impl Dda {
                     slip_tolerance,
                 });
                 // Friction acts with the normal force at the generalised-α time point.
-                let gap_alpha = alpha_f * c.gap0 + (1.0 - alpha_f) * gap;
-                let n_alpha = c.props.normal_penalty * (-gap_alpha).max(0.0);
+                let n_alpha = if augmented && c.state.is_closed() {
+                    alpha_f * c.start_normal + (1.0 - alpha_f) * normal_force
+                } else {
+                    let gap_alpha = alpha_f * c.gap0 + (1.0 - alpha_f) * gap;
+                    p * (-gap_alpha).max(0.0)
+                };
                 // The friction force uses the normal force of the previous pass (keeping K
                 // symmetric); iterate until it moves by < 1e-4: the friction force is then
                 // within 1e-4·ρN of the implicit one, far below the accuracy targets, while a
@@ -904,7 +989,7 @@ impl Dda {
                     // holds it with a spring in tension. The step is cut instead.
                     contradicted |= match c.state {
                         ContactState::Open => gap < 0.0,
-                        _ => gap > open_tolerance,
+                        _ => judged_gap > open_tolerance,
                     };
                     continue;
                 }
@@ -912,13 +997,29 @@ impl Dda {
                     c.flips += 1;
                     if c.state == c.start_state {
                         c.event_fraction = match mode {
-                            Mode::Dynamic { dt } => {
-                                transition_fraction(c, new_state, gap, slip, slip_velocity, dt)
-                            }
+                            Mode::Dynamic { dt } => transition_fraction(
+                                c,
+                                new_state,
+                                Transition {
+                                    gap_end: gap,
+                                    slip,
+                                    slip_velocity_end: slip_velocity,
+                                    shear_start,
+                                    shear_end: shear_force,
+                                    normal_end: normal_force,
+                                },
+                                dt,
+                            ),
                             Mode::Static { .. } | Mode::Modal => 1.0,
                         };
                     }
                     changed = true;
+                    // A contact that opens drops its multipliers; one that closes starts
+                    // from none; one that starts to slide keeps its normal force.
+                    if !new_state.is_closed() {
+                        c.normal_multiplier = 0.0;
+                        c.shear_multiplier = 0.0;
+                    }
                     c.state = new_state;
                 }
             }
@@ -930,6 +1031,64 @@ impl Dda {
             }
         }
         Ok(None)
+    }
+
+    /// Solves one open-close pass with the contacts' trial states: one linear solve with
+    /// penalty springs, or, with the augmented Lagrangian, solves with the same matrix
+    /// until every closed contact's constraint holds, updating the multipliers
+    /// (λ ← λ − p·g) after each. Returns the increments of all blocks.
+    fn solve_pass(
+        &mut self,
+        mode: Mode,
+        known: &[Vec6],
+        base: &System,
+        solution: &mut SmallVec<[f64; TINY_LIMIT]>,
+    ) -> Result<PerBlock<Vec6>> {
+        const MAX_ITERATIONS: usize = 200;
+        let tolerance = self.params.constraint_tolerance;
+        let mut iteration = 0;
+        loop {
+            let mut sys = match self.pass_system.take() {
+                Some(mut sys) => {
+                    sys.copy_from(base);
+                    sys
+                }
+                None => base.clone(),
+            };
+            self.add_contacts(&mut sys, known, mode);
+            self.hold_rigid_strains(&mut sys);
+            let structure = self.structure_key(mode);
+            let solved = self.linear.solve(&sys.k, sys.r.as_slice(), structure, solution);
+            self.pass_system = Some(sys);
+            solved.map_err(|e| self.solve_error(e))?;
+            let increments = self.increments(solution, known);
+            if !self.augmented() {
+                return Ok(increments);
+            }
+            let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+            for c in &mut self.contacts {
+                if !c.state.is_closed() {
+                    continue;
+                }
+                let di = &increments[c.key.vertex_block];
+                let dj = &increments[c.key.edge_block];
+                let dn = -c.props.normal_penalty * c.gap_end(di, dj);
+                c.normal_multiplier += dn;
+                worst = worst.max(dn.abs());
+                scale = scale.max(c.normal_multiplier.abs());
+                if c.state == ContactState::Locked {
+                    let ds = -c.props.shear_penalty * (c.shear0 + c.slip_increment(di, dj));
+                    c.shear_multiplier += ds;
+                    worst = worst.max(ds.abs());
+                    scale = scale.max(c.shear_multiplier.abs());
+                }
+            }
+            iteration += 1;
+            self.counters.constraint_iterations += 1;
+            if worst <= tolerance * scale || iteration >= MAX_ITERATIONS {
+                return Ok(increments);
+            }
+        }
     }
 
     /// Identifies what changes the whole system matrix (rather than its drift with the
@@ -988,13 +1147,7 @@ impl Dda {
             .iter()
             .zip(increments)
             .map(|(b, d)| match b.role {
-                BlockRole::PrescribedGround => {
-                    let v = self
-                        .motion
-                        .as_ref()
-                        .map_or(0.0, |m| m.velocity(self.time + dt));
-                    [v, 0.0, 0.0, 0.0, 0.0, 0.0]
-                }
+                BlockRole::PrescribedGround => [0.0; 6],
                 _ => {
                     let mut v = [0.0; 6];
                     for k in 0..6 {
@@ -1140,13 +1293,40 @@ impl Dda {
             b.apply_increment(d, self.params.exact_rotation)?;
         }
         self.memory.clear();
+        let augmented = self.augmented();
         for c in &self.contacts {
             let di = &increments[c.key.vertex_block];
             let dj = &increments[c.key.edge_block];
             let gap = c.gap_end(di, dj);
-            let shear =
-                yield_stretch(c, c.state, gap).unwrap_or(c.shear0 + c.slip_increment(di, dj));
-            let normal_force = c.props.normal_penalty * (-gap).max(0.0);
+            let stuck_stretch = c.shear0 + c.slip_increment(di, dj);
+            let (shear, normal_force, shear_multiplier) = if augmented {
+                // The stretch left is the constraint's residual (round-off), kept so the
+                // next step pulls it back; a sliding contact carries its friction force
+                // as the multiplier it sticks with.
+                let normal = if c.state.is_closed() {
+                    c.normal_multiplier
+                } else {
+                    0.0
+                };
+                match c.state {
+                    ContactState::Open => (0.0, 0.0, 0.0),
+                    ContactState::Locked => (stuck_stretch, normal, c.shear_multiplier),
+                    ContactState::Sliding { direction } => {
+                        let mu = if c.props.friction.is_finite() {
+                            c.props.friction
+                        } else {
+                            0.0
+                        };
+                        (0.0, normal, -direction * mu * normal.max(0.0))
+                    }
+                }
+            } else {
+                (
+                    yield_stretch(c, c.state, gap).unwrap_or(stuck_stretch),
+                    c.props.normal_penalty * (-gap).max(0.0),
+                    0.0,
+                )
+            };
             self.memory.insert(
                 c.key,
                 ContactMemory {
@@ -1158,6 +1338,7 @@ impl Dda {
                     } else {
                         0.0
                     },
+                    shear_multiplier,
                 },
             );
         }
@@ -1196,10 +1377,184 @@ impl Dda {
                 continue;
             }
             let p = c.props;
-            e += 0.5 * m.normal_force * m.normal_force / p.normal_penalty;
+            if !self.augmented() {
+                e += 0.5 * m.normal_force * m.normal_force / p.normal_penalty;
+            }
             e += 0.5 * p.shear_penalty * m.shear * m.shear;
         }
         e
+    }
+
+    /// Makes the contacts' trial states (found at the very start of a step) their start
+    /// states for the retry of the step.
+    fn adopt_trial_states(&mut self) {
+        for c in &self.contacts {
+            if c.state == c.start_state {
+                continue;
+            }
+            let m = self.memory.entry(c.key).or_insert(ContactMemory {
+                state: c.start_state,
+                shear: 0.0,
+                normal_force: 0.0,
+                normal_change: 0.0,
+                shear_multiplier: 0.0,
+            });
+            m.state = c.state;
+            m.shear = 0.0;
+            m.normal_change = 0.0;
+            if !c.state.is_closed() {
+                m.normal_force = 0.0;
+                m.shear_multiplier = 0.0;
+            }
+        }
+    }
+
+    /// Resolves the contact states right after an event (the start of the step after a
+    /// landing), exactly as the event-driven rigid-body model does: the velocities and
+    /// accelerations are projected onto the constraints of the closed contacts (see
+    /// [`Dda::project`]), and the contact forces that this takes are judged — a contact
+    /// that would have to pull opens, one whose stick force exceeds ρN slides the way it
+    /// is pulled — until the states agree with their forces. Any integrator then carries
+    /// on from a consistent state instead of ringing on the acceleration before the event.
+    fn resolve_event(&mut self) -> Result<()> {
+        self.detect_contacts();
+        let kinetic_before = self.kinetic_energy();
+        for _ in 0..=MAX_FLIPS_PER_STEP {
+            self.project(Field::Velocity)?;
+            let changes = self.project(Field::Accel)?;
+            self.project(Field::Response)?;
+            if std::env::var("DBG").is_ok() {
+                for (c, ch) in self.contacts.iter().zip(&changes) {
+                    eprintln!("t {:.6} resolve {:?} N {:.4e} S {:.4e} d {:?} v {:?}", self.time, c.start_state, c.start_normal, c.start_shear_multiplier, ch, self.blocks[1].velocity[0]);
+                }
+            }
+            let mut changed = false;
+            for (c, [dn, ds]) in self.contacts.iter_mut().zip(changes) {
+                if !c.start_state.is_closed() || c.props.bonded {
+                    continue;
+                }
+                let normal = c.start_normal + dn;
+                let shear = c.start_shear_multiplier + ds;
+                let new_state = if normal < 0.0 {
+                    ContactState::Open
+                } else if c.start_state == ContactState::Locked
+                    && shear.abs() > c.props.friction * normal * (1.0 + 1e-9)
+                {
+                    // The stick force on the vertex is −(pull): it slides the way pulled.
+                    ContactState::Sliding {
+                        direction: if shear > 0.0 { -1.0 } else { 1.0 },
+                    }
+                } else {
+                    c.start_state
+                };
+                if new_state != c.start_state {
+                    c.start_state = new_state;
+                    c.state = new_state;
+                    changed = true;
+                }
+                if let Some(m) = self.memory.get_mut(&c.key) {
+                    m.state = new_state;
+                    m.normal_force = if new_state.is_closed() { normal } else { 0.0 };
+                    m.shear_multiplier = match new_state {
+                        ContactState::Locked => shear,
+                        ContactState::Sliding { direction } => {
+                            -direction * c.props.friction * normal
+                        }
+                        ContactState::Open => 0.0,
+                    };
+                    m.normal_change = 0.0;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        self.energy.impact_dissipated += kinetic_before - self.kinetic_energy();
+        Ok(())
+    }
+
+    /// Projects the velocities or accelerations of the free blocks onto the constraints
+    /// of the contacts' start states (closed: no approach; locked: no slip), in the metric
+    /// of the mass matrix: x⁺ = x − M⁻¹Gᵀ(GM⁻¹Gᵀ)⁻¹G x, solved by the augmented
+    /// Lagrangian (redundant constraints, as a flat face on two corners, are fine).
+    /// Returns, per contact, the change of its (normal, shear) force that the projection
+    /// of the accelerations takes (in N; for velocities, the impulse in N·s).
+    fn project(&mut self, field: Field) -> Result<Vec<[f64; 2]>> {
+        let mut multipliers = vec![[0.0_f64; 2]; self.contacts.len()];
+        if !self.contacts.iter().any(|c| c.start_state.is_closed()) {
+            return Ok(multipliers);
+        }
+        let mass_factor = 1.0 / (self.coeffs.beta * self.params.dt * self.params.dt);
+        let still = vec![[0.0; 6]; self.blocks.len()];
+        let mut base = System::zeros(Arc::clone(&self.pattern), 1.0);
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if let Some(s) = self.dofs.slot[bi] {
+                base.add_diag_block(s, &b.mass, 1.0);
+                let x = field.of(b);
+                let mut mx = [0.0; 6];
+                for i in 0..6 {
+                    mx[i] = (0..6).map(|j| b.mass[i][j] * x[j]).sum();
+                }
+                base.add_rhs(s, &mx, 1.0);
+            }
+        }
+        let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
+        let key = 0x5eed_0000_0000_0001 ^ mass_factor.to_bits();
+        for _ in 0..200 {
+            let mut sys = base.clone();
+            for (c, m) in self.contacts.iter().zip(&multipliers) {
+                let p = c.props.normal_penalty / mass_factor;
+                let (i, j) = (c.key.vertex_block, c.key.edge_block);
+                if c.start_state.is_closed() {
+                    sys.add_scalar_spring(&self.dofs, &still, p, -m[0], (i, &c.gap_i), Some((j, &c.gap_j)));
+                }
+                if c.start_state == ContactState::Locked {
+                    sys.add_scalar_spring(&self.dofs, &still, p, -m[1], (i, &c.slip_i), Some((j, &c.slip_j)));
+                }
+            }
+            self.hold_rigid_strains(&mut sys);
+            self.linear
+                .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
+                .map_err(|e| self.solve_error(e))?;
+            let x = self.increments(&solution, &still);
+            let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+            for (c, m) in self.contacts.iter().zip(multipliers.iter_mut()) {
+                let p = c.props.normal_penalty / mass_factor;
+                let rate = |a: &Vec6, b: &Vec6| dot6(a, &x[c.key.vertex_block]) + dot6(b, &x[c.key.edge_block]);
+                // Force (normal: pushing apart; shear: on the vertex along t̂) that the
+                // constraint takes: λ ← λ − p·g, as for the step's contacts.
+                if c.start_state.is_closed() {
+                    let d = -p * rate(&c.gap_i, &c.gap_j);
+                    m[0] += d;
+                    worst = worst.max(d.abs());
+                    scale = scale.max(m[0].abs());
+                }
+                if c.start_state == ContactState::Locked {
+                    let d = -p * rate(&c.slip_i, &c.slip_j);
+                    m[1] += d;
+                    worst = worst.max(d.abs());
+                    scale = scale.max(m[1].abs());
+                }
+            }
+            if worst <= self.params.constraint_tolerance * scale || scale == 0.0 {
+                for (bi, b) in self.blocks.iter_mut().enumerate() {
+                    if self.dofs.slot[bi].is_some() {
+                        *field.of_mut(b) = x[bi];
+                    }
+                }
+                break;
+            }
+        }
+        Ok(multipliers)
+    }
+
+    fn kinetic_energy(&self) -> f64 {
+        self.blocks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != self.ground)
+            .map(|(_, b)| b.kinetic_energy())
+            .sum()
     }
 
     /// Advances one step (of at most `max_dt`), cutting Δt as needed.
@@ -1215,6 +1570,9 @@ impl Dda {
             };
             match restart {
                 Restart::None => {}
+                // With exact constraints the integrator need not change: the velocities
+                // and accelerations are made consistent with the new contact states.
+                _ if self.augmented() => self.resolve_event()?,
                 Restart::Event | Restart::AfterImpact => {
                     self.coeffs = super::params::Integrator::Classic.coefficients();
                 }
@@ -1300,11 +1658,42 @@ impl Dda {
                 if at_start && restart == Restart::None {
                     // The event happened at the step start: restart from here.
                     self.restart = event_kind;
+                    if self.augmented() {
+                        self.adopt_trial_states();
+                    }
                     return Ok(None);
                 }
                 // (In a restart step, an impact at its very start is part of this step.)
                 if !at_start && theta < 0.999 {
                     dt_override = Some(theta * dt);
+                    if std::env::var("DBG").is_ok() {
+                        for c in &self.contacts {
+                            eprintln!("land theta {theta} {:?}->{:?} ef {} {}", c.start_state, c.state, c.event_fraction_in_step(), c.event_fraction);
+                        }
+                    }
+                    // The states the contacts take at the event: given to them when the
+                    // shortened step ends there (and resolved at the next step's start).
+                    self.pending_events = self
+                        .contacts
+                        .iter()
+                        .filter(|c| {
+                            // Events within a thousandth of the step are one event (the
+                            // two corners of a face stick together).
+                            c.props.locate_events
+                                && (c.event_fraction_in_step() - theta).abs() <= 1e-3
+                        })
+                        .map(|c| {
+                            // A slip that reverses stops first: the event's resolution
+                            // decides whether it sticks or slides back.
+                            let state = match (c.start_state, c.state) {
+                                (ContactState::Sliding { .. }, ContactState::Sliding { .. }) => {
+                                    ContactState::Locked
+                                }
+                                (_, state) => state,
+                            };
+                            (c.key, state)
+                        })
+                        .collect();
                     self.last_landing = self.time + theta * dt;
                     continue;
                 }
@@ -1339,6 +1728,20 @@ impl Dda {
                             .contacts
                             .iter()
                             .any(|c| c.start_state.is_closed() && c.state == ContactState::Open);
+                        if self.augmented() && dt_override.is_some() {
+                            for (key, state) in std::mem::take(&mut self.pending_events) {
+                                if let Some(m) = self.memory.get_mut(&key)
+                                    && m.state != state
+                                {
+                                    m.state = state;
+                                    m.shear = 0.0;
+                                    if !state.is_closed() {
+                                        m.normal_force = 0.0;
+                                        m.shear_multiplier = 0.0;
+                                    }
+                                }
+                            }
+                        }
                         self.restart = match (dt_override.is_some(), restart) {
                             (true, _) => event_kind,
                             (false, Restart::Impact) => Restart::AfterImpact,
@@ -1392,12 +1795,9 @@ impl Dda {
         for (bi, b) in self.blocks.iter_mut().enumerate() {
             match b.role {
                 BlockRole::PrescribedGround => {
-                    let (v, a) = match &self.motion {
-                        Some(m) => (m.velocity(t_new), m.accel(t_new)),
-                        None => (0.0, 0.0),
-                    };
-                    b.velocity = [v, 0.0, 0.0, 0.0, 0.0, 0.0];
-                    b.accel = [a, 0.0, 0.0, 0.0, 0.0, 0.0];
+                    b.velocity = [0.0; 6];
+                    b.accel = [0.0; 6];
+                    b.response_accel = [0.0; 6];
                 }
                 _ => {
                     let d = &increments[bi];
@@ -1406,6 +1806,13 @@ impl Dda {
                             - b.velocity[k] / (c.beta * dt)
                             - (0.5 / c.beta - 1.0) * b.accel[k];
                         b.velocity[k] += dt * ((1.0 - c.gamma) * b.accel[k] + c.gamma * a_new);
+                        // The step balanced the forces at t + (1 − αf)Δt against the
+                        // acceleration (1 − αm)a₁ + αm a₀; unfolding the αf-average gives
+                        // the acceleration that balances them at t + Δt (the integrator's
+                        // a₁ itself lags by (αf − αm)Δt: a whole step for ρ∞ = 0).
+                        let balanced = (1.0 - c.alpha_m) * a_new + c.alpha_m * b.accel[k];
+                        b.response_accel[k] =
+                            (balanced - c.alpha_f * b.response_accel[k]) / (1.0 - c.alpha_f);
                         b.accel[k] = a_new;
                     }
                 }
@@ -1514,9 +1921,12 @@ impl Dda {
         }
         // Gravity and point loads on the structure.
         let mut external = 0.0;
+        let ground_accel = 0.5 * (self.ground_accel(self.time) + self.ground_accel(t_new));
         for (bi, b) in self.blocks.iter().enumerate() {
             if self.is_structure(bi) {
                 external -= b.total_mass() * self.gravity * increments[bi][1];
+                // The ground's acceleration as a body force in the moving frame.
+                input -= b.total_mass() * ground_accel * increments[bi][0];
             }
         }
         for l in &self.loads {
@@ -1730,19 +2140,32 @@ impl Dda {
 /// - sliding → locked: where the slip velocity, linear over the step (from its start value
 ///   and the slip increment), passes through zero;
 /// - open → closed: where the gap, linear over the step, closes.
-fn transition_fraction(
-    c: &Contact,
-    new_state: ContactState,
+/// What a trial solution says about a contact, for locating its event in the step.
+struct Transition {
     gap_end: f64,
     slip: f64,
     slip_velocity_end: f64,
-    dt: f64,
-) -> f64 {
+    /// Shear force (the pull on the stick) at the step start and end, N.
+    shear_start: f64,
+    shear_end: f64,
+    /// Normal force at the step end, N.
+    normal_end: f64,
+}
+
+fn transition_fraction(c: &Contact, new_state: ContactState, t: Transition, dt: f64) -> f64 {
+    let Transition {
+        gap_end,
+        slip,
+        slip_velocity_end,
+        shear_start,
+        shear_end,
+        normal_end,
+    } = t;
     let theta = match (c.state, new_state) {
         (ContactState::Locked, ContactState::Sliding { .. }) => {
-            let f0 = (c.props.shear_penalty * c.shear0).abs();
-            let f1 = (c.props.shear_penalty * (c.shear0 + slip)).abs();
-            let limit = c.props.friction * c.props.normal_penalty * (-gap_end).max(0.0);
+            let f0 = shear_start.abs();
+            let f1 = shear_end.abs();
+            let limit = c.props.friction * normal_end;
             if f1 > f0 {
                 (limit - f0) / (f1 - f0)
             } else {

@@ -119,9 +119,11 @@ pub fn run_dda(
         let t = d.time();
         let b = &d.blocks()[raft];
         let r = &d.blocks()[roof];
-        let slip = b.centroid_displacement()[0] - motion.displacement(t);
+        let g = &d.blocks()[d.ground()];
+        let ag = motion.accel(t);
+        let slip = b.centroid_displacement()[0] - g.centroid_displacement()[0];
         let drift = r.centroid_displacement()[0] - b.centroid_displacement()[0];
-        let row = [t, motion.accel(t), slip, drift, b.accel[0], r.accel[0]];
+        let row = [t, ag, slip, drift, b.response_accel[0] + ag, r.response_accel[0] + ag];
         for (k, p) in peaks.iter_mut().enumerate() {
             // Columns 1..5 are tracked as ground, slip, drift, base, roof.
             p.offer(t, row[k + 1]);

@@ -105,6 +105,7 @@ fn ground_block(half_length: f64) -> BlockDef {
         name: "ground".into(),
         vertices: rectangle(-half_length, -1.0, half_length, 0.0),
         material: concrete(2000.0),
+        rigid: false,
     }
 }
 
@@ -124,6 +125,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
             name: "base-slab".into(),
             vertices: rectangle(-12.3, 0.0, 12.3, t),
             material: slab,
+            rigid: false,
         },
     ];
     let mut connections = Vec::new();
@@ -140,6 +142,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
             name: floor.clone(),
             vertices: rectangle(-12.3, k as f64 * h, 12.3, k as f64 * h + t),
             material: slab,
+            rigid: false,
         });
         for (side, x0, x1) in [("left", -12.2, -11.8), ("right", 11.8, 12.2)] {
             let name = format!("column-{k}-{side}");
@@ -148,6 +151,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
                 // (y0 + 0.4 rather than y0 + t + 0.1: the same number as the TOML scene's.)
                 vertices: rectangle(x0, y0 + 0.4, x1, k as f64 * h - 0.1),
                 material: column,
+                rigid: false,
             });
             connections.extend(connection(&below, &name, x0, x1, y0 + t, y0 + 0.4));
             connections.extend(connection(
@@ -245,6 +249,7 @@ pub fn wall(n: usize) -> Result<Scene> {
             name: "base-slab".into(),
             vertices: rectangle(-0.1, 0.0, width + 0.1, 0.3),
             material: concrete(2400.0),
+            rigid: false,
         },
     ];
     let joint = |a: &str, b: &str| ContactDef {
@@ -294,6 +299,7 @@ pub fn wall(n: usize) -> Result<Scene> {
                 name: name.clone(),
                 vertices: rectangle(x0, y0, x1, y0 + h),
                 material: masonry,
+                rigid: false,
             });
             if let Some((left, _, _)) = this.last() {
                 contacts.push(joint(left, &name));

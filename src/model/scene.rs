@@ -84,6 +84,10 @@ pub struct BlockDef {
     pub vertices: Vec<Point>,
     /// Its material.
     pub material: Material,
+    /// A rigid block: its three strain unknowns are held at zero (the paper's
+    /// mass-spring model has rigid masses). Default: deformable.
+    #[serde(default)]
+    pub rigid: bool,
 }
 
 /// How the ground block moves.
