@@ -73,6 +73,8 @@ pub struct ContactMemory {
     /// edge tangent), N; while sliding, the friction force, so that a contact that sticks
     /// picks it up continuously.
     pub shear_multiplier: f64,
+    /// How much the shear multiplier changed over the last step (while locked), N.
+    pub shear_change: f64,
 }
 
 /// A contact during one step: geometry linearised at the step start plus its trial state.
@@ -125,6 +127,8 @@ pub struct Contact {
     pub shear_multiplier: f64,
     /// The shear multiplier at the step start.
     pub start_shear_multiplier: f64,
+    /// Change of the shear multiplier over the previous step, N.
+    pub previous_shear_change: f64,
     /// Contact point (P1) and edge tangent at the step start, for drawing and reports.
     pub point: Point,
     /// Edge unit tangent t̂.
@@ -368,6 +372,7 @@ fn linearise(
     let slip_i = t_transpose_times(ci, p1, t);
     let tq = t_transpose_times(cj, q, t);
     let slip_j = tq.map(|v| -v);
+    let shear_change = mem.map_or(0.0, |m| m.shear_change);
     let (start_state, shear0, normal, normal_change, shear_multiplier) = match mem {
         // The shear spring is elastic-perfectly-plastic: while sliding it stays stretched
         // at its yield value (force ρN), so a contact that stops picks up the friction
@@ -427,6 +432,7 @@ fn linearise(
         normal_multiplier: normal,
         shear_multiplier,
         start_shear_multiplier: shear_multiplier,
+        previous_shear_change: shear_change,
         point: p1,
         tangent: t,
     }

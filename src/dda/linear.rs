@@ -496,6 +496,10 @@ pub struct LinearSolver {
     /// CG work vectors: residual, preconditioned residual, direction, K·direction.
     work: [Vec<f64>; 4],
     stats: SolverStats,
+    /// The last solve factorised its matrix (rather than iterating on a kept factor).
+    fresh: bool,
+    /// Scratch for [`LinearSolver::solve_change`].
+    change: Vec<f64>,
 }
 
 /// A kept factor and what it is for.
@@ -572,6 +576,8 @@ impl Clone for LinearSolver {
             budget: self.budget,
             work: self.work.clone(),
             stats: self.stats,
+            fresh: false,
+            change: Vec::new(),
         }
     }
 }
@@ -635,6 +641,8 @@ impl LinearSolver {
             budget,
             work: std::array::from_fn(|_| vec![0.0; n]),
             stats: SolverStats::default(),
+            fresh: false,
+            change: Vec::new(),
             pattern,
         })
     }
@@ -663,6 +671,7 @@ impl LinearSolver {
             self.active = i;
             self.slots[i].used = self.stats.solves;
             if self.slots[i].spent < self.budget && self.iterate(k, rhs, x) {
+                self.fresh = false;
                 return Ok(());
             }
         }
@@ -681,9 +690,41 @@ impl LinearSolver {
         let slot = &mut self.slots[self.active];
         slot.factored = Some(structure);
         slot.used = self.stats.solves;
+        self.fresh = true;
         x.copy_from_slice(rhs);
         self.apply_inverse(x);
         Ok(())
+    }
+
+    /// Adds K⁻¹ δ to `x`, for the matrix of the last [`LinearSolver::solve`] (a change
+    /// δ of its right-hand side): by the factor alone when that solve factorised this very
+    /// matrix, else by conjugate gradients on the kept factor (to the same backward error,
+    /// relative to the change), else by a new factorisation.
+    pub fn solve_change(
+        &mut self,
+        k: &BlockMatrix,
+        delta: &[f64],
+        structure: u64,
+        x: &mut [f64],
+    ) -> Result<(), SolveError> {
+        if delta.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NonFinite);
+        }
+        let mut change = std::mem::take(&mut self.change);
+        change.resize(delta.len(), 0.0);
+        let solved = if self.fresh {
+            self.stats.solves += 1;
+            change.copy_from_slice(delta);
+            self.apply_inverse(&mut change);
+            Ok(())
+        } else {
+            self.solve(k, delta, structure, &mut change)
+        };
+        for (xi, ci) in x.iter_mut().zip(&change) {
+            *xi += ci;
+        }
+        self.change = change;
+        solved
     }
 
     /// Conjugate gradients preconditioned with the kept factor; false if the backward

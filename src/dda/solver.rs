@@ -177,7 +177,6 @@ pub struct Dda {
 #[derive(Clone, Copy)]
 enum Field {
     Velocity,
-    Accel,
     Response,
 }
 
@@ -185,7 +184,6 @@ impl Field {
     fn of(self, b: &Block) -> Vec6 {
         match self {
             Field::Velocity => b.velocity,
-            Field::Accel => b.accel,
             Field::Response => b.response_accel,
         }
     }
@@ -193,7 +191,6 @@ impl Field {
     fn of_mut(self, b: &mut Block) -> &mut Vec6 {
         match self {
             Field::Velocity => &mut b.velocity,
-            Field::Accel => &mut b.accel,
             Field::Response => &mut b.response_accel,
         }
     }
@@ -446,7 +443,7 @@ impl Dda {
     /// raised to a hundred times that, so that a few iterations reach round-off, yet
     /// not so far that the factorisation loses the soft directions (1e-16 · p/k).
     fn scale_constraint_penalties(&mut self) {
-        const FACTOR: f64 = 100.0;
+        const FACTOR: f64 = 1e4;
         let mass_factor = 1.0 / (self.coeffs.beta * self.params.dt * self.params.dt);
         let stiffness = |b: &Block| {
             if b.role == BlockRole::PrescribedGround {
@@ -474,10 +471,20 @@ impl Dda {
         if previous_dt <= 0.0 {
             return;
         }
+        let augmented = self.augmented();
         for c in &mut self.contacts {
             if c.start_state.is_closed() {
-                c.friction_normal =
-                    (c.start_normal + c.previous_normal_change * dt / previous_dt).max(0.0);
+                let predicted = c.start_normal + c.previous_normal_change * dt / previous_dt;
+                c.friction_normal = predicted.max(0.0);
+                // The multipliers start from the same prediction: the first solve then
+                // misses the constraint by O(Δt²) of the force, not O(Δt).
+                if augmented {
+                    c.normal_multiplier = predicted;
+                    if c.start_state == ContactState::Locked {
+                        c.shear_multiplier =
+                            c.start_shear_multiplier + c.previous_shear_change * dt / previous_dt;
+                    }
+                }
             }
         }
     }
@@ -528,6 +535,28 @@ impl Dda {
     /// Contacts of the last step (geometry at its start, state at its end).
     pub fn contacts(&self) -> &[Contact] {
         &self.contacts
+    }
+
+    /// The forces a contact of the last step carries: (normal force, compressive
+    /// positive; tangential pull, N — the force the stick resists or friction opposes,
+    /// positive along the edge tangent).
+    pub fn contact_force(&self, c: &Contact) -> (f64, f64) {
+        let normal = if !c.state.is_closed() {
+            0.0
+        } else if self.augmented() {
+            c.normal_multiplier
+        } else {
+            c.friction_normal
+        };
+        let tangential = match c.state {
+            ContactState::Open => 0.0,
+            ContactState::Locked if self.augmented() => -c.shear_multiplier,
+            ContactState::Locked => c.props.shear_penalty * c.shear0,
+            ContactState::Sliding { direction } => {
+                direction * c.props.friction.min(1e30) * c.friction_normal
+            }
+        };
+        (normal, tangential)
     }
 
     /// Bolts with their current end points.
@@ -584,6 +613,27 @@ impl Dda {
             .ok_or_else(|| Error::Scene(format!("unknown block '{name}'")))
     }
 
+    /// Horizontal displacement of block `b`'s centroid relative to the ground's, m (the
+    /// slip of a base block), since the reference state.
+    pub fn displacement_relative_to_ground(&self, b: usize) -> f64 {
+        self.blocks[b].centroid_displacement()[0]
+            - self.blocks[self.ground].centroid_displacement()[0]
+    }
+
+    /// Absolute horizontal acceleration of block `b`'s centroid now, m/s²: the model
+    /// moves with the ground (see [`Dda::frame_displacement`]), so the ground's
+    /// acceleration is added to the block's.
+    pub fn absolute_accel(&self, b: usize) -> f64 {
+        self.blocks[b].response_accel[0] + self.ground_accel(self.time)
+    }
+
+    /// How far the model's frame has moved with the ground, m: the solver works in a
+    /// frame that translates with the input ground motion (every block feels −m ü0), so
+    /// absolute positions are the blocks' plus this.
+    pub fn frame_displacement(&self) -> f64 {
+        self.motion.as_ref().map_or(0.0, |m| m.displacement(self.time))
+    }
+
     /// Ground acceleration at time t (the input, not the large-mass ground's response).
     pub fn ground_accel(&self, t: f64) -> f64 {
         self.motion.as_ref().map_or(0.0, |m| m.accel(t))
@@ -601,6 +651,15 @@ impl Dda {
         self.energy = EnergyTerms::default();
         self.stored_reference = self.stored_energy();
         self.energy_scale = 0.0;
+    }
+
+    /// Zeroes the strain entries of rigid blocks in a change of the right-hand side.
+    fn hold_rigid_change(&self, change: &mut [f64]) {
+        for (b, slot) in self.blocks.iter().zip(&self.dofs.slot) {
+            if let (true, Some(s)) = (b.rigid, *slot) {
+                change[s + 3..s + 6].fill(0.0);
+            }
+        }
     }
 
     /// Holds the strain unknowns of rigid blocks at zero in `sys`.
@@ -1045,50 +1104,78 @@ impl Dda {
         solution: &mut SmallVec<[f64; TINY_LIMIT]>,
     ) -> Result<PerBlock<Vec6>> {
         const MAX_ITERATIONS: usize = 200;
-        let tolerance = self.params.constraint_tolerance;
-        let mut iteration = 0;
-        loop {
-            let mut sys = match self.pass_system.take() {
-                Some(mut sys) => {
-                    sys.copy_from(base);
-                    sys
-                }
-                None => base.clone(),
-            };
-            self.add_contacts(&mut sys, known, mode);
-            self.hold_rigid_strains(&mut sys);
-            let structure = self.structure_key(mode);
-            let solved = self.linear.solve(&sys.k, sys.r.as_slice(), structure, solution);
-            self.pass_system = Some(sys);
-            solved.map_err(|e| self.solve_error(e))?;
-            let increments = self.increments(solution, known);
+        let mut sys = match self.pass_system.take() {
+            Some(mut sys) => {
+                sys.copy_from(base);
+                sys
+            }
+            None => base.clone(),
+        };
+        self.add_contacts(&mut sys, known, mode);
+        self.hold_rigid_strains(&mut sys);
+        let structure = self.structure_key(mode);
+        let solved = self.linear.solve(&sys.k, sys.r.as_slice(), structure, solution);
+        let result = solved.map_err(|e| self.solve_error(e)).and_then(|()| {
+            let mut increments = self.increments(solution, known);
             if !self.augmented() {
                 return Ok(increments);
             }
-            let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
-            for c in &mut self.contacts {
-                if !c.state.is_closed() {
-                    continue;
+            // Augmented Lagrangian: the matrix stays, only the multipliers' part of the
+            // right-hand side changes (λ enters as −λ·∇g of the constraint energy).
+            let mut change = vec![0.0; self.dofs.n];
+            for _ in 0..MAX_ITERATIONS {
+                self.counters.constraint_iterations += 1;
+                change.fill(0.0);
+                if self.update_multipliers(&increments, &mut change) {
+                    break;
                 }
-                let di = &increments[c.key.vertex_block];
-                let dj = &increments[c.key.edge_block];
-                let dn = -c.props.normal_penalty * c.gap_end(di, dj);
-                c.normal_multiplier += dn;
-                worst = worst.max(dn.abs());
-                scale = scale.max(c.normal_multiplier.abs());
-                if c.state == ContactState::Locked {
-                    let ds = -c.props.shear_penalty * (c.shear0 + c.slip_increment(di, dj));
-                    c.shear_multiplier += ds;
-                    worst = worst.max(ds.abs());
-                    scale = scale.max(c.shear_multiplier.abs());
-                }
+                self.hold_rigid_change(&mut change);
+                self.linear
+                    .solve_change(&sys.k, &change, structure, solution)
+                    .map_err(|e| self.solve_error(e))?;
+                increments = self.increments(solution, known);
             }
-            iteration += 1;
-            self.counters.constraint_iterations += 1;
-            if worst <= tolerance * scale || iteration >= MAX_ITERATIONS {
-                return Ok(increments);
+            Ok(increments)
+        });
+        self.pass_system = Some(sys);
+        result
+    }
+
+    /// One augmented-Lagrangian update, λ ← λ − p·g, of every closed contact's
+    /// multipliers from the constraint violations g at `increments`; their change is
+    /// added to `change` (a change of the right-hand side). True when the violations were
+    /// already within the tolerance (the multipliers are then the forces of `increments`).
+    fn update_multipliers(&mut self, increments: &[Vec6], change: &mut [f64]) -> bool {
+        let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+        for c in &mut self.contacts {
+            if !c.state.is_closed() {
+                continue;
+            }
+            let (i, j) = (c.key.vertex_block, c.key.edge_block);
+            let (di, dj) = (&increments[i], &increments[j]);
+            let dn = -c.props.normal_penalty * c.gap_end(di, dj);
+            c.normal_multiplier += dn;
+            worst = worst.max(dn.abs());
+            scale = scale.max(c.normal_multiplier.abs());
+            let mut changes = [(dn, &c.gap_i, &c.gap_j), (0.0, &c.slip_i, &c.slip_j)];
+            if c.state == ContactState::Locked {
+                let ds = -c.props.shear_penalty * (c.shear0 + c.slip_increment(di, dj));
+                c.shear_multiplier += ds;
+                worst = worst.max(ds.abs());
+                scale = scale.max(c.shear_multiplier.abs());
+                changes[1].0 = ds;
+            }
+            for (amount, grad_i, grad_j) in changes {
+                for (b, grad) in [(i, grad_i), (j, grad_j)] {
+                    if let Some(s) = self.dofs.slot[b] {
+                        for k in 0..6 {
+                            change[s + k] += amount * grad[k];
+                        }
+                    }
+                }
             }
         }
+        worst <= self.params.constraint_tolerance * scale
     }
 
     /// Identifies what changes the whole system matrix (rather than its drift with the
@@ -1338,6 +1425,13 @@ impl Dda {
                     } else {
                         0.0
                     },
+                    shear_change: if c.start_state == ContactState::Locked
+                        && c.state == ContactState::Locked
+                    {
+                        shear_multiplier - c.start_shear_multiplier
+                    } else {
+                        0.0
+                    },
                     shear_multiplier,
                 },
             );
@@ -1398,10 +1492,12 @@ impl Dda {
                 normal_force: 0.0,
                 normal_change: 0.0,
                 shear_multiplier: 0.0,
+                shear_change: 0.0,
             });
             m.state = c.state;
             m.shear = 0.0;
             m.normal_change = 0.0;
+            m.shear_change = 0.0;
             if !c.state.is_closed() {
                 m.normal_force = 0.0;
                 m.shear_multiplier = 0.0;
@@ -1419,14 +1515,43 @@ impl Dda {
     fn resolve_event(&mut self) -> Result<()> {
         self.detect_contacts();
         let kinetic_before = self.kinetic_energy();
+        // Each round starts again from the motion before the event: a projection is not
+        // undone by projecting on fewer constraints.
+        let before: Vec<[Vec6; 3]> = self
+            .blocks
+            .iter()
+            .map(|b| [b.velocity, b.accel, b.response_accel])
+            .collect();
+        // The tangential force each contact carried before the event (on the vertex,
+        // along t̂): a sliding contact's friction, a stuck one's multiplier.
+        let forces_before: Vec<f64> = self.contacts.iter().map(|c| c.start_shear_multiplier).collect();
         for _ in 0..=MAX_FLIPS_PER_STEP {
-            self.project(Field::Velocity)?;
-            let changes = self.project(Field::Accel)?;
-            self.project(Field::Response)?;
-            if std::env::var("DBG").is_ok() {
-                for (c, ch) in self.contacts.iter().zip(&changes) {
-                    eprintln!("t {:.6} resolve {:?} N {:.4e} S {:.4e} d {:?} v {:?}", self.time, c.start_state, c.start_normal, c.start_shear_multiplier, ch, self.blocks[1].velocity[0]);
+            for (b, saved) in self.blocks.iter_mut().zip(&before) {
+                [b.velocity, b.accel, b.response_accel] = *saved;
+            }
+            // Friction that changes at the event (a slip that reverses, a stick that
+            // breaks at a force other than ρN) changes the accelerations as well.
+            let mut friction_change = vec![0.0; self.dofs.n];
+            for (c, &old) in self.contacts.iter().zip(&forces_before) {
+                if let ContactState::Sliding { direction } = c.start_state {
+                    let change = -direction * c.props.friction.min(1e30) * c.start_normal - old;
+                    for (blk, grad) in [(c.key.vertex_block, &c.slip_i), (c.key.edge_block, &c.slip_j)] {
+                        if let Some(s) = self.dofs.slot[blk] {
+                            for k in 0..6 {
+                                friction_change[s + k] += change * grad[k];
+                            }
+                        }
+                    }
                 }
+            }
+            self.hold_rigid_change(&mut friction_change);
+            self.project(Field::Velocity, None)?;
+            let changes = self.project(Field::Response, Some(&friction_change))?;
+            // The integrator restarts from the event as from an initial state: its
+            // acceleration variable is the acceleration that balances the forces (for the
+            // generalised-α family the variable otherwise lags the forces).
+            for b in &mut self.blocks {
+                b.accel = b.response_accel;
             }
             let mut changed = false;
             for (c, [dn, ds]) in self.contacts.iter_mut().zip(changes) {
@@ -1452,17 +1577,19 @@ impl Dda {
                     c.state = new_state;
                     changed = true;
                 }
+                let shear_force = match new_state {
+                    ContactState::Locked => shear,
+                    ContactState::Sliding { direction } => {
+                        -direction * c.props.friction.min(1e30) * normal
+                    }
+                    ContactState::Open => 0.0,
+                };
                 if let Some(m) = self.memory.get_mut(&c.key) {
                     m.state = new_state;
                     m.normal_force = if new_state.is_closed() { normal } else { 0.0 };
-                    m.shear_multiplier = match new_state {
-                        ContactState::Locked => shear,
-                        ContactState::Sliding { direction } => {
-                            -direction * c.props.friction * normal
-                        }
-                        ContactState::Open => 0.0,
-                    };
+                    m.shear_multiplier = shear_force;
                     m.normal_change = 0.0;
+                    m.shear_change = 0.0;
                 }
             }
             if !changed {
@@ -1479,7 +1606,9 @@ impl Dda {
     /// Lagrangian (redundant constraints, as a flat face on two corners, are fine).
     /// Returns, per contact, the change of its (normal, shear) force that the projection
     /// of the accelerations takes (in N; for velocities, the impulse in N·s).
-    fn project(&mut self, field: Field) -> Result<Vec<[f64; 2]>> {
+    /// `extra`: generalised forces added to the field's momentum (M x + extra), for the
+    /// accelerations the force changes the event makes besides the constraints'.
+    fn project(&mut self, field: Field, extra: Option<&[f64]>) -> Result<Vec<[f64; 2]>> {
         let mut multipliers = vec![[0.0_f64; 2]; self.contacts.len()];
         if !self.contacts.iter().any(|c| c.start_state.is_closed()) {
             return Ok(multipliers);
@@ -1496,6 +1625,11 @@ impl Dda {
                     mx[i] = (0..6).map(|j| b.mass[i][j] * x[j]).sum();
                 }
                 base.add_rhs(s, &mx, 1.0);
+            }
+        }
+        if let Some(extra) = extra {
+            for (r, e) in base.r.iter_mut().zip(extra) {
+                *r += e;
             }
         }
         let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);

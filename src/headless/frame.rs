@@ -251,15 +251,14 @@ pub fn run_frame(req: &FrameRequest) -> Result<FrameOutcome> {
     let mut last_slip = 0.0;
     dda.run_until(duration, |d, _| {
         let t = d.time();
-        let b = &d.blocks()[base];
-        let top = &d.blocks()[roof];
-        let slip = b.centroid_displacement()[0] - motion.displacement(t);
-        let drift = top.centroid_displacement()[0] - b.centroid_displacement()[0];
+        let slip = d.displacement_relative_to_ground(base);
+        let drift = d.displacement_relative_to_ground(roof) - slip;
+        let (a_base, a_roof) = (d.absolute_accel(base), d.absolute_accel(roof));
         PeakTracker::offer(&mut slip_pk, t, slip);
-        PeakTracker::offer(&mut base_pk, t, b.accel[0]);
-        PeakTracker::offer(&mut roof_pk, t, top.accel[0]);
+        PeakTracker::offer(&mut base_pk, t, a_base);
+        PeakTracker::offer(&mut roof_pk, t, a_roof);
         PeakTracker::offer(&mut drift_pk, t, drift);
-        history.push(&[t, motion.accel(t), slip, b.accel[0], top.accel[0], drift]);
+        history.push(&[t, motion.accel(t), slip, a_base, a_roof, drift]);
         last_slip = slip;
     })?;
     let counters = dda.counters();

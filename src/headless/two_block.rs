@@ -117,13 +117,16 @@ pub fn run_dda(
             sliding_steps += 1;
         }
         let t = d.time();
-        let b = &d.blocks()[raft];
-        let r = &d.blocks()[roof];
-        let g = &d.blocks()[d.ground()];
-        let ag = motion.accel(t);
-        let slip = b.centroid_displacement()[0] - g.centroid_displacement()[0];
-        let drift = r.centroid_displacement()[0] - b.centroid_displacement()[0];
-        let row = [t, ag, slip, drift, b.response_accel[0] + ag, r.response_accel[0] + ag];
+        let slip = d.displacement_relative_to_ground(raft);
+        let drift = d.displacement_relative_to_ground(roof) - slip;
+        let row = [
+            t,
+            motion.accel(t),
+            slip,
+            drift,
+            d.absolute_accel(raft),
+            d.absolute_accel(roof),
+        ];
         for (k, p) in peaks.iter_mut().enumerate() {
             // Columns 1..5 are tracked as ground, slip, drift, base, roof.
             p.offer(t, row[k + 1]);

@@ -110,9 +110,11 @@ impl Extractor {
         }
     }
 
-    fn local(&self, p: Point) -> [f32; 2] {
+    /// A solver point in the picture's coordinates: the solver's frame moves with the
+    /// ground by `shift` (see `Dda::frame_displacement`), the picture's does not.
+    fn local(&self, p: Point, shift: f64) -> [f32; 2] {
         [
-            (p[0] - self.origin[0]) as f32,
+            (p[0] + shift - self.origin[0]) as f32,
             (p[1] - self.origin[1]) as f32,
         ]
     }
@@ -121,6 +123,7 @@ impl Extractor {
     pub fn extract(&self, dda: &Dda, motion: Option<&GroundMotion>) -> ModelFrame {
         let t = dda.time();
         let g = dda.ground();
+        let shift = dda.frame_displacement();
         let blocks = dda
             .blocks()
             .iter()
@@ -130,11 +133,11 @@ impl Extractor {
                 let (s, co) = b.rotation.sin_cos();
                 let rigid = self.offsets[i]
                     .iter()
-                    .map(|o| self.local([c[0] + co * o[0] - s * o[1], c[1] + s * o[0] + co * o[1]]))
+                    .map(|o| self.local([c[0] + co * o[0] - s * o[1], c[1] + s * o[0] + co * o[1]], shift))
                     .collect();
                 let r = &self.reference_strain[i];
                 BlockFrame {
-                    vertices: b.vertices.iter().map(|&v| self.local(v)).collect(),
+                    vertices: b.vertices.iter().map(|&v| self.local(v, shift)).collect(),
                     rigid,
                     stress: b.stress.map(|v| v as f32),
                     strain: [
@@ -151,32 +154,30 @@ impl Extractor {
             .contacts()
             .iter()
             .map(|c| {
-                let n = c.friction_normal;
+                let (n, pull) = dda.contact_force(c);
                 // Force on the structure: minus the spring (or friction) force along the
                 // tangent on the vertex side; the reaction on the edge side.
                 if c.key.edge_block == g {
-                    joint_force -= contact_tangential_force(c) * c.tangent[0];
+                    joint_force -= pull * c.tangent[0];
                 } else if c.key.vertex_block == g {
-                    joint_force += contact_tangential_force(c) * c.tangent[0];
+                    joint_force += pull * c.tangent[0];
                 }
                 ContactFrame {
-                    point: self.local(c.point),
+                    point: self.local(c.point, shift),
                     tangent: [c.tangent[0] as f32, c.tangent[1] as f32],
                     normal_force: n as f32,
                     state: c.state.code(),
                 }
             })
             .collect();
-        let base = &dda.blocks()[self.base];
-        let roof = &dda.blocks()[self.roof];
-        let ground_disp = motion.map_or(0.0, |m| m.displacement(t));
+        let slip = dda.displacement_relative_to_ground(self.base);
         let probes = Probes {
             ground_accel: motion.map_or(0.0, |m| m.accel(t)),
-            ground_disp,
-            base_accel: base.accel[0],
-            roof_accel: roof.accel[0],
-            slip: base.centroid_displacement()[0] - ground_disp,
-            drift: roof.centroid_displacement()[0] - base.centroid_displacement()[0],
+            ground_disp: dda.frame_displacement(),
+            base_accel: dda.absolute_accel(self.base),
+            roof_accel: dda.absolute_accel(self.roof),
+            slip,
+            drift: dda.displacement_relative_to_ground(self.roof) - slip,
             joint_force,
             energy: dda.energy(),
         };
@@ -187,27 +188,15 @@ impl Extractor {
             bolts: dda
                 .bolts()
                 .iter()
-                .map(|b| [self.local(b.points[0]), self.local(b.points[1])])
+                .map(|b| [self.local(b.points[0], shift), self.local(b.points[1], shift)])
                 .collect(),
             connections: dda
                 .connections()
                 .iter()
-                .map(|c| c.nodes.map(|p| self.local(p)))
+                .map(|c| c.nodes.map(|p| self.local(p, shift)))
                 .collect(),
             probes,
         }
     }
 }
 
-/// Tangential force of a contact's shear spring or friction (positive along the tangent,
-/// as it resists the vertex's slip): p_s·s when stuck, ±ρN when sliding.
-fn contact_tangential_force(c: &crate::dda::contact::Contact) -> f64 {
-    use crate::dda::judge::ContactState;
-    match c.state {
-        ContactState::Open => 0.0,
-        ContactState::Locked => c.props.shear_penalty * c.shear0,
-        ContactState::Sliding { direction } => {
-            direction * c.props.friction.min(1e30) * c.friction_normal
-        }
-    }
-}
