@@ -25,11 +25,16 @@ pub struct EnergyTerms {
     /// hitting vertex's approach velocity is removed within the step), and the energy the
     /// impact steps remove is counted here rather than as numerical dissipation.
     pub impact_dissipated: f64,
+    /// What the time integrator dissipated (positive) or created (negative), computed
+    /// from its own states (see `Dda::commit_step`); zero for the trapezoidal rule.
+    pub numerical_dissipated: f64,
 }
 
 impl EnergyTerms {
-    /// Numerical dissipation: what the integrator lost (positive) or created (negative).
-    /// Zero to round-off for the trapezoidal rule on a linear problem.
+    /// What the balance does not account for: the input and external work less every
+    /// energy stored and dissipated, the integrator's dissipation included. Zero to
+    /// round-off for a model whose terms are all consistent; the rest is the model's
+    /// inconsistency (geometric nonlinearity, unconverged constraints).
     pub fn residual(&self) -> f64 {
         self.input_work + self.external_work
             - self.kinetic
@@ -37,21 +42,19 @@ impl EnergyTerms {
             - self.friction_dissipated
             - self.contact_damping
             - self.impact_dissipated
+            - self.numerical_dissipated
     }
 
-    /// Residual relative to the energy that passed through the system.
-    pub fn residual_relative(&self) -> f64 {
-        let scale = self.input_work.abs().max(self.external_work.abs()).max(
+    /// The energy that has passed through now: the larger of the works done and of what
+    /// is stored and dissipated.
+    pub fn scale(&self) -> f64 {
+        self.input_work.abs().max(self.external_work.abs()).max(
             self.kinetic
                 + self.strain.abs()
-                + self.friction_dissipated
-                + self.contact_damping
-                + self.impact_dissipated,
-        );
-        if scale > 0.0 {
-            self.residual() / scale
-        } else {
-            0.0
-        }
+                + self.friction_dissipated.abs()
+                + self.contact_damping.abs()
+                + self.impact_dissipated.abs()
+                + self.numerical_dissipated.abs(),
+        )
     }
 }

@@ -173,6 +173,17 @@ pub struct Dda {
     pending_events: Vec<(contact::ContactKey, ContactState)>,
 }
 
+/// xᵀ M y for a block's 6×6 matrix.
+fn quadratic(m: &super::block::Mat6, x: &Vec6, y: &Vec6) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..6 {
+        for j in 0..6 {
+            sum += x[i] * m[i][j] * y[j];
+        }
+    }
+    sum
+}
+
 /// Which state of the blocks a projection acts on.
 #[derive(Clone, Copy)]
 enum Field {
@@ -675,8 +686,10 @@ impl Dda {
         self.params.contact_enforcement == super::params::ContactEnforcement::AugmentedLagrangian
     }
 
+    /// Whether block `b` moves in the model's frame (everything but a prescribed
+    /// ground, which stands still in it): the energy balance is the balance of these.
     fn is_structure(&self, b: usize) -> bool {
-        b != self.ground
+        self.blocks[b].role != BlockRole::PrescribedGround
     }
 
     /// The blocks' centroids at the step start, the origins of their unknowns (a copy,
@@ -1682,12 +1695,12 @@ impl Dda {
         Ok(multipliers)
     }
 
+    /// Kinetic energy of every block that moves in the model's frame.
     fn kinetic_energy(&self) -> f64 {
         self.blocks
             .iter()
-            .enumerate()
-            .filter(|(i, _)| *i != self.ground)
-            .map(|(_, b)| b.kinetic_energy())
+            .filter(|b| b.role != BlockRole::PrescribedGround)
+            .map(Block::kinetic_energy)
             .sum()
     }
 
@@ -1921,10 +1934,13 @@ impl Dda {
         ratio: f64,
         impact: bool,
     ) -> Result<StepReport> {
-        let residual_before = self.energy.residual();
         let c = self.coeffs;
         let t_new = self.time + dt;
-        let start_velocities: PerBlock<Vec6> = self.blocks.iter().map(|b| b.velocity).collect();
+        let start: PerBlock<[Vec6; 2]> = self
+            .blocks
+            .iter()
+            .map(|b| [b.velocity, b.response_accel])
+            .collect();
         // Newmark update of velocities and accelerations.
         for (bi, b) in self.blocks.iter_mut().enumerate() {
             match b.role {
@@ -1952,10 +1968,26 @@ impl Dda {
                 }
             }
         }
-        // Work and dissipation over the step.
-        let g = self.ground;
-        let dg = increments[g];
-        let mut input = 0.0;
+        // The integrator's own dissipation, from its states alone: the work of the average
+        // of the forces at the step's ends (M â, with â the accelerations that balance
+        // them) on the increment, less the change of kinetic energy (both with the step's
+        // mass matrix). Zero for the trapezoidal rule; what the residual leaves is then
+        // the model's own inconsistency, not the scheme's.
+        let mut numerical = 0.0;
+        for ((b, d), [v0, a0]) in self.blocks.iter().zip(increments).zip(&start) {
+            if b.role == BlockRole::PrescribedGround {
+                continue;
+            }
+            let mut a_mean = [0.0; 6];
+            for k in 0..6 {
+                a_mean[k] = 0.5 * (a0[k] + b.response_accel[k]);
+            }
+            numerical += quadratic(&b.mass, &a_mean, d)
+                - 0.5 * quadratic(&b.mass, &b.velocity, &b.velocity)
+                + 0.5 * quadratic(&b.mass, v0, v0);
+        }
+        // Friction and contact counts.
+        let augmented = self.augmented();
         let mut dissipated = 0.0;
         let mut max_pen = 0.0_f64;
         let (mut closed, mut sliding) = (0, 0);
@@ -1968,37 +2000,18 @@ impl Dda {
                 closed += 1;
                 max_pen = max_pen.max(-gap);
             }
-            // Which side (if any) is the ground, and the ground part of each gradient.
-            let ground_side = if j == g {
-                Some(false)
-            } else if i == g {
-                Some(true)
-            } else {
-                None
-            };
-            let pick = |vi: &Vec6, vj: &Vec6| match ground_side {
-                Some(true) => dot6(vi, &dg),
-                Some(false) => dot6(vj, &dg),
-                None => 0.0,
-            };
-            match ct.state {
-                ContactState::Open => {}
-                ContactState::Locked => {
-                    let p = ct.props.normal_penalty;
-                    input += 0.5 * p * (ct.gap0 + gap) * pick(&ct.gap_i, &ct.gap_j);
-                    let ps = ct.props.shear_penalty;
-                    input += 0.5 * ps * (2.0 * ct.shear0 + slip) * pick(&ct.slip_i, &ct.slip_j);
-                }
-                ContactState::Sliding { direction } => {
-                    sliding += 1;
-                    let p = ct.props.normal_penalty;
-                    input += 0.5 * p * (ct.gap0 + gap) * pick(&ct.gap_i, &ct.gap_j);
-                    let f = ct.props.friction * ct.friction_normal;
-                    input += direction * f * pick(&ct.slip_i, &ct.slip_j);
-                    // Plastic slip: the slip minus the change of the spring's elastic stretch.
+            if let ContactState::Sliding { direction } = ct.state {
+                sliding += 1;
+                let f = ct.props.friction * ct.friction_normal;
+                dissipated += if augmented {
+                    // The friction force on the vertex, averaged over the step's ends (at
+                    // its start, whatever the contact carried then), times the slip.
+                    -0.5 * (ct.start_shear_multiplier - direction * f) * slip
+                } else {
+                    // Plastic slip: the slip minus the change of the spring's stretch.
                     let elastic = yield_stretch(ct, ct.state, gap).unwrap_or(0.0) - ct.shear0;
-                    dissipated += f * (direction * (slip - elastic)).max(0.0);
-                }
+                    f * (direction * (slip - elastic)).max(0.0)
+                };
             }
         }
         // Contact dashpots: force c·q̇ at the α point times the relative displacement.
@@ -2010,97 +2023,53 @@ impl Dda {
                 if damping == 0.0 {
                     continue;
                 }
-                let q0 = self.directional_velocity(i, a, j, b, &|k| start_velocities[k]);
+                let q0 = self.directional_velocity(i, a, j, b, &|k| start[k][0]);
                 let q1 = self.directional_velocity(i, a, j, b, &|k| self.blocks[k].velocity);
                 let force = damping * ((1.0 - c.alpha_f) * q1 + c.alpha_f * q0);
-                let dq = dot6(a, &increments[i]) + dot6(b, &increments[j]);
-                damped += force * dq;
-                // The ground side of the dashpot does work on the structure too.
-                if j == g {
-                    input += force * dot6(b, &dg);
-                } else if i == g {
-                    input += force * dot6(a, &dg);
-                }
+                damped += force * (dot6(a, &increments[i]) + dot6(b, &increments[j]));
             }
         }
-        // Joints that tie the structure to the ground.
+        // Work of the loads: gravity and point loads, and the ground's acceleration, which
+        // in the frame moving with the ground is a body force −m ü0 on every block (but
+        // the paper's large-mass ground, whose driving force m_g ü0 cancels it).
         let centroids = self.centroids();
-        let ground_elements: Vec<ElementTerms> = self
-            .bolts
-            .iter()
-            .filter(|b| b.blocks.contains(&g) && b.blocks.iter().any(|&k| k != g))
-            .map(Bolt::terms)
-            .chain(
-                self.connections
-                    .iter()
-                    .filter(|c| c.blocks.contains(&g) && c.blocks.iter().any(|&k| k != g))
-                    .map(Connection::terms),
-            )
-            .collect();
-        for e in &ground_elements {
-            let u: Vec<Point> = e
-                .nodes()
-                .iter()
-                .map(|&(b, x)| point_displacement(centroids[b], x, &increments[b]))
-                .collect();
-            let end = e.end_forces(&u);
-            let fe = e.fe();
-            for (k, &(b, _)) in e.nodes().iter().enumerate() {
-                if b == g {
-                    input += 0.5
-                        * ((fe[2 * k] + end[2 * k]) * u[k][0]
-                            + (fe[2 * k + 1] + end[2 * k + 1]) * u[k][1]);
-                }
-            }
-        }
-        // Gravity and point loads on the structure.
         let mut external = 0.0;
+        let mut input = 0.0;
         let ground_accel = 0.5 * (self.ground_accel(self.time) + self.ground_accel(t_new));
-        for (bi, b) in self.blocks.iter().enumerate() {
-            if self.is_structure(bi) {
-                external -= b.total_mass() * self.gravity * increments[bi][1];
-                // The ground's acceleration as a body force in the moving frame.
-                input -= b.total_mass() * ground_accel * increments[bi][0];
+        for (b, d) in self.blocks.iter().zip(increments) {
+            if b.role == BlockRole::PrescribedGround {
+                continue;
+            }
+            external -= b.total_mass() * self.gravity * d[1];
+            if b.role != BlockRole::LargeMassGround {
+                input -= b.total_mass() * ground_accel * d[0];
             }
         }
         for l in &self.loads {
-            if self.is_structure(l.block) {
-                let u = point_displacement(centroids[l.block], l.point, &increments[l.block]);
-                external += l.force[0] * u[0] + l.force[1] * u[1];
-            }
+            let u = point_displacement(centroids[l.block], l.point, &increments[l.block]);
+            external += l.force[0] * u[0] + l.force[1] * u[1];
         }
         self.commit_geometry(increments)?;
         self.time = t_new;
 
-        self.energy.input_work += input;
-        self.energy.external_work += external;
-        self.energy.friction_dissipated += dissipated;
-        self.energy.contact_damping += damped;
-        self.energy.kinetic = self
-            .blocks
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| *i != g)
-            .map(|(_, b)| b.kinetic_energy())
-            .sum();
-        self.energy.strain = self.stored_energy() - self.stored_reference;
+        let e = &mut self.energy;
+        e.input_work += input;
+        e.external_work += external;
+        e.friction_dissipated += dissipated;
+        e.contact_damping += damped;
         if impact {
-            // What this step lost beyond friction and dashpots is the impact's loss (signed:
-            // keeping only the losses would bias the residual of many small impacts).
-            self.energy.impact_dissipated += self.energy.residual() - residual_before;
-        }
-        self.energy_scale = self.energy_scale.max(self.energy.input_work.abs()).max(
-            self.energy.kinetic
-                + self.energy.strain.abs()
-                + self.energy.friction_dissipated
-                + self.energy.impact_dissipated,
-        );
-        let residual_rel = if self.energy_scale > 0.0 {
-            self.energy.residual().abs() / self.energy_scale
+            // A plastic impact step (penalty contacts): what the scheme removed is the
+            // impact's loss.
+            e.impact_dissipated += numerical;
         } else {
-            0.0
-        };
-
+            e.numerical_dissipated += numerical;
+        }
+        let kinetic = self.kinetic_energy();
+        let strain = self.stored_energy() - self.stored_reference;
+        self.energy.kinetic = kinetic;
+        self.energy.strain = strain;
+        self.energy_scale = self.energy_scale.max(self.energy.scale());
+        let residual_rel = self.energy_residual_relative().abs();
         if self.blocks.iter().any(|b| {
             b.velocity
                 .iter()
@@ -2136,13 +2105,19 @@ impl Dda {
         Ok(report)
     }
 
-    /// Relative energy residual now: |residual| / the largest energy that has passed through.
+    /// Relative energy residual now: the residual over the largest energy that has passed
+    /// through the model, or over a floor of 1e-12 of its weight times its size when
+    /// nothing has (a model that never moves has no relative error to report).
     pub fn energy_residual_relative(&self) -> f64 {
-        if self.energy_scale > 0.0 {
-            self.energy.residual() / self.energy_scale
-        } else {
-            0.0
-        }
+        let weight: f64 = self
+            .blocks
+            .iter()
+            .filter(|b| b.role != BlockRole::PrescribedGround)
+            .map(|b| b.total_mass())
+            .sum::<f64>()
+            * self.gravity.max(1.0);
+        let floor = 1e-12 * weight * self.structure_size;
+        self.energy.residual() / self.energy_scale.max(floor)
     }
 
     /// Natural frequencies and mode shapes of the model about its current state, with every
