@@ -8,10 +8,10 @@ use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use slidebase::dda::Integrator;
-use slidebase::headless::run::{RunRequest, run, write_outputs};
+use slidebase::headless::run::{OUTPUT_HISTORY, run_setup, write_outputs};
 use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, parse_shard, run_sweep};
-use slidebase::headless::two_block::ModelKind;
 use slidebase::model::scene::GroundKind;
+use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 
 /// Buildings on a sliding (friction) base under earthquakes, computed with Discontinuous
 /// Deformation Analysis and checked against the exact mass-spring solution.
@@ -308,28 +308,47 @@ fn out(line: &str) -> Result<()> {
 fn cmd_run(args: RunArgs) -> Result<()> {
     let integrator = Integrator::parse(&args.integrator)?;
     let scene = slidebase::model::presets::resolve_scene(&args.scene)?;
-    if scene.structure.is_some() {
-        return cmd_run_frame(args, integrator);
+    let building = scene.structure.is_some();
+    if building && (args.alpha.is_some() || args.freq_ratio.is_some()) {
+        bail!(
+            "invalid --alpha/--freq-ratio: they set up the two-block scene, not '{}'",
+            args.scene
+        );
     }
-    let req = RunRequest {
-        scene: args.scene,
-        alpha: args.alpha.unwrap_or(0.5),
-        friction: args.friction.unwrap_or(0.1),
-        freq_ratio: args.freq_ratio.unwrap_or(1.0),
-        amplitude_g: args.amplitude_g,
-        duration: args.duration,
-        dt: args.dt,
-        integrator,
+    let excitation = match &args.record {
+        Some(name) => ExcitationSpec::record(name.clone()),
+        None if building => ExcitationSpec::Scene,
+        None => ExcitationSpec::Harmonic {
+            amplitude_g: Some(args.amplitude_g),
+            frequency: Some(Frequency::Ratio(args.freq_ratio.unwrap_or(1.0))),
+        },
+    };
+    let history = match (&args.out, building) {
+        (None, _) => HistoryPlan::PeaksOnly,
+        (Some(_), false) => OUTPUT_HISTORY,
+        (Some(_), true) => HistoryPlan::EverySteps(1),
+    };
+    let spec = RunSpec {
+        scene: scene.into(),
         model: args.model.into(),
+        excitation,
+        alpha: args.alpha,
+        friction: args.friction,
         fixed_base: args.fixed_base,
-        record: args.record,
         ground: args.ground.map(|g| match g {
             GroundArg::Prescribed => GroundKind::Prescribed,
             GroundArg::LargeMass => GroundKind::LargeMass,
         }),
-        record_every: 10,
+        duration: args.duration,
+        dt: Some(args.dt),
+        integrator: Some(integrator),
+        history,
     };
-    let outcome = run(&req)?;
+    let setup = spec.prepare()?;
+    if building {
+        return cmd_run_frame(&args, &setup);
+    }
+    let outcome = run_setup(&setup)?;
     if let Some(dir) = &args.out {
         let files = write_outputs(&outcome, dir)?;
         if !args.json {
@@ -525,27 +544,8 @@ fn cmd_bench(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-fn cmd_run_frame(args: RunArgs, integrator: Integrator) -> Result<()> {
-    use slidebase::headless::frame::{FrameRequest, run_frame, run_mdof};
-    if args.alpha.is_some() || args.freq_ratio.is_some() {
-        bail!(
-            "invalid --alpha/--freq-ratio: they set up the two-block scene, not '{}'",
-            args.scene
-        );
-    }
-    let req = FrameRequest {
-        scene: args.scene,
-        record: args.record,
-        friction: args.friction,
-        fixed_base: args.fixed_base,
-        dt: args.dt,
-        integrator,
-        duration: args.duration,
-    };
-    let outcome = match args.model {
-        ModelArg::Dda => run_frame(&req)?,
-        ModelArg::MassSpring => run_mdof(&req)?,
-    };
+fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<()> {
+    let outcome = slidebase::headless::frame::run_building_setup(setup)?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         outcome.history.write_csv(&dir.join("history.csv"))?;
@@ -777,13 +777,12 @@ fn cmd_default() -> Result<()> {
     out("           DDA (generalised-α) against the exact mass-spring model\n")?;
     let mut rows = Vec::new();
     for model in [ModelKind::MassSpring, ModelKind::Dda] {
-        let req = RunRequest {
+        let spec = RunSpec {
             model,
             duration: Some(20.0),
-            record_every: 0,
-            ..RunRequest::default()
+            ..RunSpec::default()
         };
-        rows.push(run(&req)?.summary);
+        rows.push(slidebase::headless::run::run(&spec)?.summary);
     }
     out(&format!("  {:<22}{:>14}{:>14}", "", "mass-spring", "DDA"))?;
     let line = |name: &str, f: &dyn Fn(&slidebase::headless::run::RunSummary) -> f64| {

@@ -12,14 +12,14 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::frame::{FrameRequest, run_frame};
-use super::run::{RunRequest, run};
+use super::frame::run_frame;
+use super::run::run;
 use super::sweep::{SweepRequest, parse_ratios, run_sweep};
-use super::two_block::ModelKind;
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, resolve_record};
 use crate::model::presets::resolve_scene;
 use crate::post::plot::{Figure, LegendCorner, Series};
+use crate::setup::{ModelKind, RunSpec};
 use crate::{Error, Result};
 
 /// What to measure.
@@ -179,11 +179,10 @@ fn measure(
 
 /// The paper's two-block model (α = 0.5, ρ = 0.1, resonance, 0.3 g, 100 s).
 fn two_block(model: ModelKind) -> Result<(f64, u64, f64)> {
-    let req = RunRequest {
+    let req = RunSpec {
         duration: Some(100.0),
-        record_every: 0,
         model,
-        ..RunRequest::default()
+        ..RunSpec::default()
     };
     let start = Instant::now();
     let o = run(&req)?;
@@ -192,9 +191,9 @@ fn two_block(model: ModelKind) -> Result<(f64, u64, f64)> {
 
 /// The three-storey frame on El Centro, Δt = 1 ms.
 fn three_storey(fixed_base: bool) -> Result<(f64, u64, f64)> {
-    let req = FrameRequest {
+    let req = RunSpec {
         fixed_base,
-        ..FrameRequest::default()
+        ..RunSpec::scene("three-storey")
     };
     let start = Instant::now();
     let o = run_frame(&req)?;

@@ -5,14 +5,15 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::simulate::{self, ModelRun, SPECTRUM_DT, SPECTRUM_MAX_SAMPLES};
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
 use crate::dda::{Dda, Integrator, SolverParams};
-use crate::ground_motion::{GroundMotion, STANDARD_GRAVITY, resolve_record};
+use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::Scene;
-use crate::model::presets::resolve_scene;
 use crate::model::scene::{ExcitationDef, StructureRoles};
-use crate::post::history::{History, PeakTracker};
-use crate::post::spectrum::{fourier_amplitude, resample_uniform};
+use crate::post::history::History;
+use crate::post::spectrum::{UniformSeries, fourier_amplitude, resample_uniform};
+use crate::setup::{ModelKind, RunSetup, RunSpec};
 use crate::{Error, Result};
 
 /// The paper's natural frequencies of its three-storey frame, Hz.
@@ -90,39 +91,6 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
     })
 }
 
-/// A run of a building scene.
-#[derive(Debug, Clone)]
-pub struct FrameRequest {
-    /// Built-in scene name or TOML path.
-    pub scene: String,
-    /// Record (built-in name or file); `None`: the scene's excitation.
-    pub record: Option<String>,
-    /// Friction coefficient of the sliding joint; `None`: the scene's.
-    pub friction: Option<f64>,
-    /// Fixed base: the joint is bonded.
-    pub fixed_base: bool,
-    /// Time step, s.
-    pub dt: f64,
-    /// Integrator.
-    pub integrator: Integrator,
-    /// Duration, s; `None`: the record's length.
-    pub duration: Option<f64>,
-}
-
-impl Default for FrameRequest {
-    fn default() -> Self {
-        Self {
-            scene: "three-storey".into(),
-            record: None,
-            friction: None,
-            fixed_base: false,
-            dt: 1e-3,
-            integrator: Integrator::default(),
-            duration: None,
-        }
-    }
-}
-
 /// Summary of a building run (the JSON object of `run --json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct FrameSummary {
@@ -176,169 +144,88 @@ pub struct FrameSummary {
 pub struct FrameOutcome {
     /// Summary.
     pub summary: FrameSummary,
-    /// Histories: time_s, ground_accel, slip, base_accel, roof_accel, roof_drift (SI).
+    /// Histories, [`HISTORY_COLUMNS`] (SI), as the setup's history plan asked.
     pub history: History,
 }
 
-/// History columns of a building run.
-pub const FRAME_COLUMNS: [&str; 6] = [
-    "time_s",
-    "ground_accel_m_s2",
-    "slip_m",
-    "base_accel_m_s2",
-    "roof_accel_m_s2",
-    "roof_drift_m",
-];
-
-/// Loads the scene and motion of a request, applying friction, fixed base and record.
-pub fn prepare(req: &FrameRequest) -> Result<(Scene, StructureRoles, GroundMotion, f64)> {
-    crate::error::require_positive("--dt", req.dt)?;
-    let mut scene = resolve_scene(&req.scene)?;
-    let r = roles(&scene)?;
-    if let Some(f) = req.friction {
-        if f.is_nan() || f < 0.0 {
-            return Err(Error::invalid(
-                "--friction",
-                format!("must be >= 0, got {f}"),
-            ));
-        }
-        for c in scene.contacts.iter_mut().filter(|c| c.name == r.joint) {
-            c.friction = f;
-        }
-    }
-    if req.fixed_base {
-        for c in scene.contacts.iter_mut().filter(|c| c.name == r.joint) {
-            c.bonded = true;
-        }
-    }
-    let (record, scale) = match (&req.record, &scene.excitation) {
-        (Some(name), _) => (name.clone(), 1.0),
-        (None, ExcitationDef::Record { record, scale }) => (record.clone(), *scale),
-        (None, _) => {
-            return Err(Error::invalid(
-                "--record",
-                "the scene has no record; give one with --record",
-            ));
-        }
-    };
-    let mut rec = resolve_record(&record)?;
-    if scale != 1.0 {
-        rec = rec.scaled(scale)?;
-    }
-    let motion = GroundMotion::Record(std::sync::Arc::new(rec));
-    let duration = match req.duration {
-        Some(d) => crate::error::require_positive("--duration", d)?,
-        None => motion.duration().unwrap_or(30.0),
-    };
-    Ok((scene, r, motion, duration))
+/// Runs a building scene with the model the specification names (DDA or the equivalent
+/// MDOF mass-spring model).
+pub fn run_building(spec: &RunSpec) -> Result<FrameOutcome> {
+    let setup = spec.prepare()?;
+    run_building_setup(&setup)
 }
 
-/// Runs the DDA model of a building scene.
-pub fn run_frame(req: &FrameRequest) -> Result<FrameOutcome> {
-    let (scene, r, motion, duration) = prepare(req)?;
-    let start = Instant::now();
-    let params = SolverParams {
-        dt: req.dt,
-        duration,
-        integrator: req.integrator,
-        ..SolverParams::default()
-    };
-    let mut dda = Dda::new(&scene, Some(motion.clone()), params)?;
-    let base = dda.block_index(&r.base)?;
-    let roof = dda.block_index(r.floors.last().map_or(&r.base, |s| s))?;
-    let mut history = History::new(&FRAME_COLUMNS);
-    let (mut slip_pk, mut base_pk, mut roof_pk, mut drift_pk) = Default::default();
-    let mut last_slip = 0.0;
-    dda.run_until(duration, |d, _| {
-        let t = d.time();
-        let b = &d.blocks()[base];
-        let top = &d.blocks()[roof];
-        let slip = b.centroid_displacement()[0] - motion.displacement(t);
-        let drift = top.centroid_displacement()[0] - b.centroid_displacement()[0];
-        PeakTracker::offer(&mut slip_pk, t, slip);
-        PeakTracker::offer(&mut base_pk, t, b.accel[0]);
-        PeakTracker::offer(&mut roof_pk, t, top.accel[0]);
-        PeakTracker::offer(&mut drift_pk, t, drift);
-        history.push(&[t, motion.accel(t), slip, b.accel[0], top.accel[0], drift]);
-        last_slip = slip;
-    })?;
-    let counters = dda.counters();
-    let summary = summarise(
-        &scene,
-        "dda",
-        req,
-        &motion,
-        duration,
-        &history,
-        [slip_pk, base_pk, roof_pk, drift_pk],
-        last_slip,
-        counters.steps,
-        start,
-    )?;
+/// Runs a prepared building setup.
+pub fn run_building_setup(setup: &RunSetup) -> Result<FrameOutcome> {
+    if setup.two_block().is_some() {
+        return Err(Error::invalid(
+            "--scene",
+            format!(
+                "scene '{}' is a two-block scene, not a building (no [structure] section)",
+                setup.scene.name
+            ),
+        ));
+    }
+    match setup.model {
+        ModelKind::Dda => run_frame_setup(setup),
+        ModelKind::MassSpring => run_mdof_setup(setup),
+    }
+}
+
+/// Runs the DDA model of a building scene (whatever model the specification names).
+pub fn run_frame(spec: &RunSpec) -> Result<FrameOutcome> {
+    run_frame_setup(&spec.prepare()?)
+}
+
+fn run_frame_setup(setup: &RunSetup) -> Result<FrameOutcome> {
+    let run = simulate::run_dda(setup, &setup.scene, setup.solver_params())?;
+    let series = run.base_accel_series.clone();
+    let summary = summarise(setup, ModelKind::Dda, &run, series)?;
     Ok(FrameOutcome {
-        summary: FrameSummary {
-            open_close_passes: counters.passes,
-            dt_cuts: counters.cuts,
-            factorizations: counters.factorizations,
-            max_penetration_ratio: counters.max_penetration_ratio,
-            energy_residual_rel: dda.energy_residual_relative(),
-            ..summary
-        },
-        history,
+        summary,
+        history: run.history,
     })
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The summary of a building run from its peaks and the resampled base acceleration.
 fn summarise(
-    scene: &Scene,
-    model: &str,
-    req: &FrameRequest,
-    motion: &GroundMotion,
-    duration: f64,
-    history: &History,
-    peaks: [PeakTracker; 4],
-    residual_slip: f64,
-    steps: u64,
-    start: Instant,
+    setup: &RunSetup,
+    model: ModelKind,
+    run: &ModelRun,
+    base_accel: Option<UniformSeries>,
 ) -> Result<FrameSummary> {
-    let t = history.column("time_s").unwrap_or_default();
-    let a = history.column("base_accel_m_s2").unwrap_or_default();
-    let fft_dt = 0.005;
-    let uniform = resample_uniform(t, a, fft_dt)?;
-    let peak_freq = fourier_amplitude(&uniform, fft_dt)?
-        .peak(0.05, 20.0)
-        .map_or(f64::NAN, |p| p.0);
-    let [slip, base, roof, drift] = peaks;
+    let peak_freq = match base_accel {
+        Some(series) => {
+            let (samples, dt) = series.finish();
+            fourier_amplitude(&samples, dt)?
+                .peak(0.05, 20.0)
+                .map_or(f64::NAN, |p| p.0)
+        }
+        None => f64::NAN,
+    };
+    let p = &run.peaks;
     Ok(FrameSummary {
-        scene: scene.name.clone(),
-        model: model.into(),
-        integrator: req.integrator.label(),
-        record: motion.label(),
-        friction: if req.fixed_base {
-            None
-        } else {
-            scene
-                .structure
-                .as_ref()
-                .and_then(|r| scene.contacts.iter().find(|c| c.name == r.joint))
-                .map(|c| c.friction)
-        },
-        fixed_base: req.fixed_base,
-        duration_s: duration,
-        max_slip_m: slip.value,
-        residual_slip_m: residual_slip,
-        peak_roof_accel_g: roof.value / STANDARD_GRAVITY,
-        peak_base_accel_g: base.value / STANDARD_GRAVITY,
-        peak_ground_accel_g: motion.peak_accel(duration) / STANDARD_GRAVITY,
-        peak_roof_drift_m: drift.value,
+        scene: setup.scene.name.clone(),
+        model: model.label().into(),
+        integrator: setup.integrator.label(),
+        record: setup.motion.label(),
+        friction: (!setup.fixed_base).then_some(setup.friction),
+        fixed_base: setup.fixed_base,
+        duration_s: setup.duration,
+        max_slip_m: p.slip_m,
+        residual_slip_m: run.residual_slip_m,
+        peak_roof_accel_g: p.roof_accel / STANDARD_GRAVITY,
+        peak_base_accel_g: p.base_accel / STANDARD_GRAVITY,
+        peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
+        peak_roof_drift_m: p.drift_m,
         base_accel_peak_freq_hz: peak_freq,
-        steps,
-        open_close_passes: 0,
-        dt_cuts: 0,
-        factorizations: 0,
-        max_penetration_ratio: 0.0,
-        energy_residual_rel: 0.0,
-        wall_time_s: start.elapsed().as_secs_f64(),
+        steps: run.steps,
+        open_close_passes: run.passes,
+        dt_cuts: run.cuts,
+        factorizations: run.factorizations,
+        max_penetration_ratio: run.max_penetration_ratio,
+        energy_residual_rel: run.energy_residual_rel,
+        wall_time_s: run.wall_time_s,
     })
 }
 
@@ -462,62 +349,46 @@ fn fit_storey_stiffnesses(masses: &[f64], target_hz: &[f64]) -> Result<Vec<f64>>
     Ok(k)
 }
 
-/// Runs the equivalent MDOF mass-spring model of a building scene on the same record.
-pub fn run_mdof(req: &FrameRequest) -> Result<FrameOutcome> {
-    let (scene, _, motion, duration) = prepare(req)?;
+/// Output interval of the MDOF model's time history, s: the base-acceleration spectrum is
+/// computed from it.
+const MDOF_OUTPUT_DT: f64 = 0.002;
+
+/// Runs the equivalent MDOF mass-spring model of a building scene (whatever model the
+/// specification names).
+pub fn run_mdof(spec: &RunSpec) -> Result<FrameOutcome> {
+    run_mdof_setup(&spec.prepare()?)
+}
+
+fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
     let start = Instant::now();
-    let (mut building, _) = equivalent_mdof(&scene)?;
-    if req.fixed_base {
+    let (mut building, _) = equivalent_mdof(&setup.scene)?;
+    if setup.fixed_base {
         building.friction = f64::INFINITY;
     }
-    let out_dt = 0.002;
+    let motion = &setup.motion;
     let r = simulate(
         &building,
-        &motion,
-        duration,
-        out_dt,
+        motion,
+        setup.duration,
+        MDOF_OUTPUT_DT,
         &ExactOptions::default(),
     )?;
-    let top = building.storey_masses.len() - 1;
-    let mut history = History::new(&FRAME_COLUMNS);
-    for k in 0..r.time.len() {
-        let t = r.time[k];
-        history.push(&[
-            t,
-            motion.accel(t),
-            r.slip[k],
-            r.raft_accel[k],
-            r.storey_accel[top][k],
-            r.storey_drift[top][k],
-        ]);
+    let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
+    for (&t, &a) in r.time.iter().zip(&r.raft_accel) {
+        series.push(t, a);
     }
-    let pk = |v: f64| PeakTracker {
-        value: v,
-        time: 0.0,
-    };
-    let mut summary = summarise(
-        &scene,
-        "mass-spring",
-        req,
-        &motion,
-        duration,
-        &history,
-        [
-            pk(r.peaks.slip),
-            pk(r.peaks.raft_accel),
-            pk(r.peaks.roof_accel),
-            pk(r.peaks.roof_drift),
-        ],
-        r.residual_slip,
-        r.steps,
-        start,
-    )?;
-    summary.energy_residual_rel = if r.energy.input_work != 0.0 {
+    let residual = if r.energy.input_work != 0.0 {
         r.energy.residual / r.energy.input_work
     } else {
         0.0
     };
-    Ok(FrameOutcome { summary, history })
+    let keep = setup.history.stride() > 0;
+    let run = simulate::exact_model_run(&r, motion, keep, 1.0, residual, start);
+    let summary = summarise(setup, ModelKind::MassSpring, &run, Some(series))?;
+    Ok(FrameOutcome {
+        summary,
+        history: run.history,
+    })
 }
 
 /// Natural frequencies measured from a free-vibration run of the fixed-base frame (an

@@ -5,14 +5,13 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::frame::{
-    FrameOutcome, FrameRequest, PAPER_FREQUENCIES_HZ, equivalent_mdof, run_frame, run_mdof,
-};
+use super::frame::{FrameOutcome, PAPER_FREQUENCIES_HZ, equivalent_mdof, run_frame, run_mdof};
 use crate::dda::Integrator;
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::presets::resolve_scene;
 use crate::post::plot::{Figure, Series};
 use crate::post::spectrum::{Spectrum, fourier_amplitude, resample_uniform};
+use crate::setup::{ExcitationSpec, HistoryPlan, RunSpec};
 use crate::{Error, Result};
 
 /// What `report` needs.
@@ -47,22 +46,38 @@ pub struct ReportRuns {
     pub mdof_fixed: FrameOutcome,
 }
 
+impl ReportRequest {
+    /// The run specification of the sliding DDA run (the others vary it).
+    pub fn spec(&self) -> RunSpec {
+        RunSpec {
+            excitation: self
+                .record
+                .clone()
+                .map_or(ExcitationSpec::Scene, ExcitationSpec::record),
+            friction: self.friction,
+            dt: Some(self.dt),
+            duration: self.duration,
+            // The figures show every step.
+            history: HistoryPlan::EverySteps(1),
+            ..RunSpec::scene(self.scene.as_str())
+        }
+    }
+}
+
 /// Runs everything a report shows.
 pub fn run_all(req: &ReportRequest) -> Result<ReportRuns> {
-    let base = FrameRequest {
-        scene: req.scene.clone(),
-        record: req.record.clone(),
-        friction: req.friction,
-        dt: req.dt,
-        duration: req.duration,
-        ..FrameRequest::default()
-    };
-    let fixed = FrameRequest {
+    let base = req.spec();
+    let fixed = RunSpec {
         fixed_base: true,
         ..base.clone()
     };
-    let classic = |r: &FrameRequest| FrameRequest {
-        integrator: Integrator::Classic,
+    let classic = |r: &RunSpec| RunSpec {
+        integrator: Some(Integrator::Classic),
+        ..r.clone()
+    };
+    // The exact model has no time step: its history is sampled at its own interval.
+    let mdof = |r: &RunSpec| RunSpec {
+        dt: None,
         ..r.clone()
     };
     Ok(ReportRuns {
@@ -70,8 +85,8 @@ pub fn run_all(req: &ReportRequest) -> Result<ReportRuns> {
         fixed: run_frame(&fixed)?,
         sliding_classic: run_frame(&classic(&base))?,
         fixed_classic: run_frame(&classic(&fixed))?,
-        mdof_sliding: run_mdof(&base)?,
-        mdof_fixed: run_mdof(&fixed)?,
+        mdof_sliding: run_mdof(&mdof(&base))?,
+        mdof_fixed: run_mdof(&mdof(&fixed))?,
     })
 }
 
@@ -149,11 +164,7 @@ pub fn write_report(req: &ReportRequest, runs: &ReportRuns, out: &Path) -> Resul
     )?;
     // The record's own samples (not the solver's history, resampled): its spectrum has
     // three nearly equal peaks (1.50, 2.14, 1.18 Hz), and interpolation reorders them.
-    let (_, _, motion, _) = super::frame::prepare(&FrameRequest {
-        scene: req.scene.clone(),
-        record: req.record.clone(),
-        ..FrameRequest::default()
-    })?;
+    let motion = req.spec().prepare()?.motion;
     let g_spec = match &motion {
         crate::ground_motion::GroundMotion::Record(r) => fourier_amplitude(r.samples(), r.dt)?,
         _ => spectrum_of(s, "ground_accel_m_s2")?,

@@ -4,63 +4,10 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::two_block::{self, ModelKind, TwoBlockRun};
-use crate::dda::{Integrator, SolverParams};
-use crate::ground_motion::{GroundMotion, Harmonic, STANDARD_GRAVITY, resolve_record};
-use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground, resolve_scene};
-use crate::model::scene::{ExcitationDef, GroundKind};
+use super::simulate::{self, ModelRun};
+use crate::ground_motion::STANDARD_GRAVITY;
+use crate::setup::{ModelKind, RunSetup, RunSpec, defaults};
 use crate::{Error, Result};
-
-/// Everything a run needs; the command-line flags map one to one onto these fields.
-#[derive(Debug, Clone)]
-pub struct RunRequest {
-    /// Built-in scene name or TOML path.
-    pub scene: String,
-    /// Mass ratio α = m/(M + m) (two-mass scenes).
-    pub alpha: f64,
-    /// Friction coefficient ρ of the sliding joint.
-    pub friction: f64,
-    /// Ω/ω of the harmonic excitation (two-mass scenes).
-    pub freq_ratio: f64,
-    /// Amplitude of the harmonic excitation, g.
-    pub amplitude_g: f64,
-    /// Duration, s; `None`: 100 s for harmonic input (the paper's), the record's length otherwise.
-    pub duration: Option<f64>,
-    /// Time step, s.
-    pub dt: f64,
-    /// Integrator.
-    pub integrator: Integrator,
-    /// DDA or the exact mass-spring model.
-    pub model: ModelKind,
-    /// Fixed base: the joint never slides.
-    pub fixed_base: bool,
-    /// A record (built-in name or file) instead of harmonic input.
-    pub record: Option<String>,
-    /// Ground model for DDA (None: the scene's).
-    pub ground: Option<GroundKind>,
-    /// Keep every n-th step in the recorded history.
-    pub record_every: usize,
-}
-
-impl Default for RunRequest {
-    fn default() -> Self {
-        Self {
-            scene: "two-block".into(),
-            alpha: 0.5,
-            friction: 0.1,
-            freq_ratio: 1.0,
-            amplitude_g: 0.3,
-            duration: None,
-            dt: 1e-3,
-            integrator: Integrator::default(),
-            model: ModelKind::Dda,
-            fixed_base: false,
-            record: None,
-            ground: None,
-            record_every: 10,
-        }
-    }
-}
 
 /// The one-object summary printed by `--json` and written by `--out`.
 #[derive(Debug, Clone, Serialize)]
@@ -125,160 +72,51 @@ pub struct RunOutcome {
     /// The summary.
     pub summary: RunSummary,
     /// The full result (histories).
-    pub run: TwoBlockRun,
+    pub run: ModelRun,
 }
 
-/// The scene and motion of a two-mass request, ready to run.
-#[derive(Debug, Clone)]
-pub struct TwoBlockSetup {
-    /// The scene with α, ρ, Ω/ω, ground and fixed base applied.
-    pub scene: crate::model::Scene,
-    /// The ground motion.
-    pub motion: GroundMotion,
-    /// Duration, s.
-    pub duration: f64,
-    /// Ω/ω (harmonic input only).
-    pub freq_ratio: Option<f64>,
-    /// `harmonic` or the record name.
-    pub excitation: String,
-    /// The scene's two-mass roles.
-    pub roles: crate::model::scene::TwoBlockRoles,
-    /// Friction actually used (∞ for a fixed base).
-    pub friction: f64,
+/// Runs one two-mass simulation as specified.
+pub fn run(spec: &RunSpec) -> Result<RunOutcome> {
+    let setup = spec.prepare()?;
+    run_setup(&setup)
 }
 
-/// Builds the scene and motion of a two-mass request (shared by `run`, the accuracy and
-/// stability studies).
-pub fn two_block_setup(req: &RunRequest) -> Result<TwoBlockSetup> {
-    crate::error::require_positive("--dt", req.dt)?;
-    if let Some(d) = req.duration {
-        crate::error::require_positive("--duration", d)?;
-    }
-    let friction = if req.fixed_base {
-        f64::INFINITY
-    } else {
-        req.friction
-    };
-    let params = TwoBlockParams {
-        alpha: req.alpha,
-        friction,
-        freq_ratio: req.freq_ratio,
-        amplitude_g: req.amplitude_g,
-    };
-    params.validate()?;
-    let mut scene = resolve_scene(&req.scene)?;
-    let roles = scene.two_block.clone().ok_or_else(|| {
+/// Runs a prepared two-mass setup.
+pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
+    let (roles, alpha, freq_ratio) = setup.two_block().ok_or_else(|| {
         Error::invalid(
             "--scene",
             format!(
                 "scene '{}' is not a two-mass scene (no [two_block] section)",
-                scene.name
+                setup.scene.name
             ),
         )
     })?;
-    apply_two_block(&mut scene, &params)?;
     let structure_hz = roles.structure_frequency_hz;
-    let (motion, omega_ratio, excitation) = match &req.record {
-        None => {
-            let h = Harmonic::from_g_hz(req.amplitude_g, req.freq_ratio * structure_hz)?;
-            (
-                GroundMotion::Harmonic(h),
-                Some(req.freq_ratio),
-                "harmonic".to_string(),
-            )
-        }
-        Some(name) => {
-            let r = resolve_record(name)?;
-            let label = r.name.clone();
-            scene.excitation = ExcitationDef::Record {
-                record: name.clone(),
-                scale: 1.0,
-            };
-            (GroundMotion::Record(std::sync::Arc::new(r)), None, label)
+    let duration = setup.duration;
+    let a_max = setup.motion.peak_accel(duration);
+    let run = match setup.model {
+        ModelKind::Dda => simulate::run_dda(setup, &setup.scene, setup.solver_params())?,
+        ModelKind::MassSpring => {
+            simulate::run_exact_two_block(setup, setup.dt * setup.history.stride() as f64)?
         }
     };
-    let duration = match (req.duration, motion.duration()) {
-        (Some(d), _) => d,
-        (None, Some(d)) => d,
-        (None, None) => 100.0,
-    };
-    // The raft can slide as far as the ground moves: make sure the ground is long enough.
-    let travel = max_abs_displacement(&motion, duration);
-    extend_ground(&mut scene, 1.2 * travel + 10.0)?;
-    if req.fixed_base {
-        for c in &mut scene.contacts {
-            if c.name == roles.joint {
-                c.bonded = true;
-            }
-        }
-    }
-    if let Some(kind) = req.ground {
-        scene.ground.kind = kind;
-    }
-    Ok(TwoBlockSetup {
-        scene,
-        motion,
-        duration,
-        freq_ratio: omega_ratio,
-        excitation,
-        roles,
-        friction,
-    })
-}
-
-/// Runs one two-mass simulation as requested.
-pub fn run(req: &RunRequest) -> Result<RunOutcome> {
-    let TwoBlockSetup {
-        scene,
-        motion,
-        duration,
-        freq_ratio: omega_ratio,
-        excitation,
-        roles,
-        friction,
-    } = two_block_setup(req)?;
-    let structure_hz = roles.structure_frequency_hz;
-    let a_max = motion.peak_accel(duration);
-    let run = match req.model {
-        ModelKind::Dda => {
-            let solver = SolverParams {
-                dt: req.dt,
-                duration,
-                integrator: req.integrator,
-                ..SolverParams::default()
-            };
-            two_block::run_dda(&scene, &motion, solver, req.record_every)?
-        }
-        ModelKind::MassSpring => two_block::run_exact(
-            req.alpha,
-            structure_hz,
-            roles.total_mass,
-            friction,
-            &motion,
-            duration,
-            req.dt * req.record_every as f64,
-        )?,
-    };
-    let d_scale = omega_ratio.map(|r| {
+    let d_scale = freq_ratio.map(|r| {
         let big_omega = 2.0 * std::f64::consts::PI * structure_hz * r;
         a_max / (big_omega * big_omega)
     });
     let summary = RunSummary {
-        scene: scene.name.clone(),
-        model: req.model.label().into(),
-        integrator: req.integrator.label(),
-        alpha: req.alpha,
-        friction: if req.fixed_base {
-            None
-        } else {
-            Some(req.friction)
-        },
-        fixed_base: req.fixed_base,
-        freq_ratio: omega_ratio,
-        excitation,
+        scene: setup.scene.name.clone(),
+        model: setup.model.label().into(),
+        integrator: setup.integrator.label(),
+        alpha,
+        friction: (!setup.fixed_base).then_some(setup.friction),
+        fixed_base: setup.fixed_base,
+        freq_ratio,
+        excitation: setup.excitation_label.clone(),
         amplitude_g: a_max / STANDARD_GRAVITY,
         duration_s: duration,
-        dt_s: req.dt,
+        dt_s: setup.dt,
         us_max_over_d: d_scale.map(|d| run.peaks.slip_m / d),
         ur_max_over_d: d_scale.map(|d| run.peaks.drift_m / d),
         abase_over_aground: run.peaks.base_accel / a_max,
@@ -298,13 +136,9 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
     Ok(RunOutcome { summary, run })
 }
 
-/// Largest |ground displacement| over [0, duration] (sampled finely enough for a bound).
-fn max_abs_displacement(motion: &GroundMotion, duration: f64) -> f64 {
-    let n = 2000;
-    (0..=n)
-        .map(|k| motion.displacement(duration * k as f64 / n as f64).abs())
-        .fold(0.0, f64::max)
-}
+/// The history a two-block run written to a folder keeps.
+pub const OUTPUT_HISTORY: crate::setup::HistoryPlan =
+    crate::setup::HistoryPlan::EverySteps(defaults::TWO_BLOCK_HISTORY_EVERY);
 
 /// Writes a run's histories and summary into `dir`.
 pub fn write_outputs(outcome: &RunOutcome, dir: &PathBuf) -> Result<Vec<PathBuf>> {

@@ -2,10 +2,10 @@
 
 use rayon::prelude::*;
 
-use super::run::{RunRequest, run};
-use super::two_block::ModelKind;
+use super::run::run;
 use crate::dda::Integrator;
 use crate::post::sweep::SweepRow;
+use crate::setup::{ExcitationSpec, Frequency, ModelKind, RunSpec};
 use crate::{Error, Result};
 
 /// A grid of two-mass runs.
@@ -152,17 +152,19 @@ pub fn run_sweep(
         .jobs()
         .par_iter()
         .map(|&(model, alpha, friction, freq_ratio)| {
-            let request = RunRequest {
-                alpha,
-                friction,
-                freq_ratio,
-                amplitude_g: req.amplitude_g,
-                duration: Some(req.duration),
-                dt: req.dt,
-                integrator: req.integrator,
+            let request = RunSpec {
                 model,
-                record_every: 0,
-                ..RunRequest::default()
+                excitation: ExcitationSpec::Harmonic {
+                    amplitude_g: Some(req.amplitude_g),
+                    frequency: Some(Frequency::Ratio(freq_ratio)),
+                },
+                alpha: Some(alpha),
+                friction: Some(friction),
+                duration: Some(req.duration),
+                // The exact model has no time step or integrator.
+                dt: (model == ModelKind::Dda).then_some(req.dt),
+                integrator: (model == ModelKind::Dda).then_some(req.integrator),
+                ..RunSpec::default()
             };
             let out = run(&request);
             tick();
