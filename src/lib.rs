@@ -24,6 +24,7 @@ pub mod dda;
 pub mod error;
 pub mod ground_motion;
 pub mod headless;
+pub mod limits;
 pub mod linalg;
 pub mod model;
 pub mod post;

@@ -21,9 +21,10 @@ fn sweep(
         frictions,
         freq_ratios: ratios,
         amplitude_g: 0.3,
-        duration,
-        dt: 1e-3,
-        integrator: Integrator::default(),
+        duration: Some(duration),
+        dt: Some(1e-3),
+        integrator: Some(Integrator::default()),
+        confirm_large: false,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: None,
     };

@@ -9,11 +9,12 @@ use serde::{Deserialize, Serialize};
 
 use super::frame::{run_frame, run_mdof};
 use super::simulate::{self, ModelRun};
+use crate::Result;
 use crate::dda::{Integrator, SolverParams};
 use crate::model::scene::GroundKind;
+use crate::post::output::Staged;
 use crate::post::plot::{Figure, Series};
 use crate::setup::{ExcitationSpec, HistoryPlan, RunSpec};
-use crate::{Error, Result};
 
 /// One run of the study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -514,16 +515,8 @@ pub fn observed_order(points: &[(f64, f64)], floor: f64) -> Option<f64> {
 
 /// Writes `work_precision.csv`, the figures and `report.md`.
 pub fn write_accuracy(rows: &[AccuracyRow], out: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let csv_path = out.join("work_precision.csv");
-    let mut w = csv::Writer::from_path(&csv_path)
-        .map_err(|e| Error::Scene(format!("{}: {e}", csv_path.display())))?;
-    for r in rows {
-        w.serialize(r)
-            .map_err(|e| Error::Scene(format!("{}: {e}", csv_path.display())))?;
-    }
-    w.flush().map_err(|e| Error::io(&csv_path, e))?;
-    let mut files = vec![csv_path];
+    let mut staged = Staged::new(out)?;
+    staged.write_csv("work_precision.csv", rows)?;
     let labels: Vec<String> = {
         let mut v: Vec<String> = rows.iter().map(|r| r.integrator.clone()).collect();
         v.sort();
@@ -565,9 +558,7 @@ pub fn write_accuracy(rows: &[AccuracyRow], out: &Path) -> Result<Vec<PathBuf>> 
             ));
         }
     }
-    let path = out.join("work_precision.png");
-    fig.save_png(&path, 1400, 600)?;
-    files.push(path);
+    fig.save_png(&staged.path("work_precision.png"), 1400, 600)?;
     // Convergence: error against Δt, fixed base (smooth) and sliding (resonant case).
     let mut fig = Figure::new("Convergence with Δt", 1, 2);
     for (pi, (study, case_filter, title)) in [
@@ -619,13 +610,9 @@ pub fn write_accuracy(rows: &[AccuracyRow], out: &Path) -> Result<Vec<PathBuf>> 
             ));
         }
     }
-    let path = out.join("convergence.png");
-    fig.save_png(&path, 1400, 600)?;
-    files.push(path);
-    let md = out.join("report.md");
-    std::fs::write(&md, report_markdown(rows)).map_err(|e| Error::io(&md, e))?;
-    files.push(md);
-    Ok(files)
+    fig.save_png(&staged.path("convergence.png"), 1400, 600)?;
+    staged.write("report.md", report_markdown(rows))?;
+    staged.commit()
 }
 
 fn report_markdown(rows: &[AccuracyRow]) -> String {

@@ -1,30 +1,36 @@
 //! `slidebase run`: one simulation of a scene, summarised in the paper's terms.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use super::simulate::{self, ModelRun};
 use crate::ground_motion::STANDARD_GRAVITY;
+use crate::post::output::Staged;
 use crate::setup::{ModelKind, RunSetup, RunSpec, defaults};
 use crate::{Error, Result};
 
-/// The one-object summary printed by `--json` and written by `--out`.
+/// The one-object summary printed by `--json` and written by `--out`. A quantity that is
+/// undefined for the run is left out (never `null`, NaN or inf); `warnings` says why when
+/// it is not obvious, and what else the user should know.
 #[derive(Debug, Clone, Serialize)]
 pub struct RunSummary {
     /// Scene name.
     pub scene: String,
     /// `dda` or `mass-spring`.
     pub model: String,
-    /// Integrator (DDA).
-    pub integrator: String,
+    /// Integrator (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<String>,
     /// Mass ratio α.
     pub alpha: f64,
-    /// Friction coefficient ρ (null when the base is fixed).
+    /// Friction coefficient ρ (absent when the base is fixed).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
     /// Whether the base was fixed.
     pub fixed_base: bool,
     /// Ω/ω (harmonic input only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub freq_ratio: Option<f64>,
     /// Excitation: `harmonic` or the record name.
     pub excitation: String,
@@ -32,16 +38,21 @@ pub struct RunSummary {
     pub amplitude_g: f64,
     /// Duration, s.
     pub duration_s: f64,
-    /// Nominal time step, s.
-    pub dt_s: f64,
+    /// Nominal time step, s (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dt_s: Option<f64>,
     /// max|u_s| / D with D = a_max/Ω² (harmonic input only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub us_max_over_d: Option<f64>,
     /// max|u_r| / D (harmonic input only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ur_max_over_d: Option<f64>,
-    /// max|a_base| / a_max (absolute accelerations).
-    pub abase_over_aground: f64,
-    /// max|a_roof| / a_max.
-    pub aroof_over_aground: f64,
+    /// max|a_base| / a_max (absolute accelerations; absent when a_max = 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub abase_over_aground: Option<f64>,
+    /// max|a_roof| / a_max (absent when a_max = 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub aroof_over_aground: Option<f64>,
     /// max|u_s|, m.
     pub us_max_m: f64,
     /// max|u_r|, m.
@@ -64,6 +75,8 @@ pub struct RunSummary {
     pub friction_dissipated_j: f64,
     /// Wall-clock time of the solve, s.
     pub wall_time_s: f64,
+    /// What the user should know: resolution, quantities left out and why.
+    pub warnings: Vec<String>,
 }
 
 /// A finished run: summary and histories.
@@ -105,10 +118,19 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         let big_omega = 2.0 * std::f64::consts::PI * structure_hz * r;
         a_max / (big_omega * big_omega)
     });
+    let mut warnings = setup.warnings.clone();
+    if a_max <= 0.0 {
+        warnings.push(format!(
+            "the ground does not accelerate in the first {duration} s: the ratios to its \
+             peak (and to D) are undefined and left out"
+        ));
+    }
+    let exact = setup.model == ModelKind::MassSpring;
+    let ratio = |x: f64, by: f64| finite(x / by).filter(|_| by > 0.0);
     let summary = RunSummary {
         scene: setup.scene.name.clone(),
         model: setup.model.label().into(),
-        integrator: setup.integrator.label(),
+        integrator: (!exact).then(|| setup.integrator.label()),
         alpha,
         friction: (!setup.fixed_base).then_some(setup.friction),
         fixed_base: setup.fixed_base,
@@ -116,11 +138,11 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         excitation: setup.excitation_label.clone(),
         amplitude_g: a_max / STANDARD_GRAVITY,
         duration_s: duration,
-        dt_s: setup.dt,
-        us_max_over_d: d_scale.map(|d| run.peaks.slip_m / d),
-        ur_max_over_d: d_scale.map(|d| run.peaks.drift_m / d),
-        abase_over_aground: run.peaks.base_accel / a_max,
-        aroof_over_aground: run.peaks.roof_accel / a_max,
+        dt_s: (!exact).then_some(setup.dt),
+        us_max_over_d: d_scale.and_then(|d| ratio(run.peaks.slip_m, d)),
+        ur_max_over_d: d_scale.and_then(|d| ratio(run.peaks.drift_m, d)),
+        abase_over_aground: ratio(run.peaks.base_accel, a_max),
+        aroof_over_aground: ratio(run.peaks.roof_accel, a_max),
         us_max_m: run.peaks.slip_m,
         ur_max_m: run.peaks.drift_m,
         residual_slip_m: run.residual_slip_m,
@@ -132,8 +154,32 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         input_work_j: run.input_work,
         friction_dissipated_j: run.friction_dissipated,
         wall_time_s: run.wall_time_s,
+        warnings,
     };
+    check_finite(&summary, duration)?;
     Ok(RunOutcome { summary, run })
+}
+
+/// `Some(x)` when x is finite.
+pub fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// The guarantee of every summary: its JSON carries no `null` (a NaN or inf would be
+/// written as one). A run that produced a non-finite number is a solver failure, reported
+/// as such rather than printed.
+pub fn check_finite<T: Serialize>(summary: &T, end_time: f64) -> Result<()> {
+    let value = serde_json::to_value(summary)
+        .map_err(|e| Error::invalid("summary", format!("cannot serialise: {e}")))?;
+    if let serde_json::Value::Object(map) = value
+        && let Some((key, _)) = map.iter().find(|(_, v)| v.is_null())
+    {
+        return Err(Error::Solver {
+            time: end_time,
+            reason: format!("the run produced a non-finite {key}"),
+        });
+    }
+    Ok(())
 }
 
 /// The history a two-block run written to a folder keeps.
@@ -141,21 +187,14 @@ pub const OUTPUT_HISTORY: crate::setup::HistoryPlan =
     crate::setup::HistoryPlan::EverySteps(defaults::TWO_BLOCK_HISTORY_EVERY);
 
 /// Writes a run's histories and summary into `dir`.
-pub fn write_outputs(outcome: &RunOutcome, dir: &PathBuf) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let csv = dir.join("history.csv");
-    outcome.run.history.write_csv(&csv)?;
-    let json = dir.join("summary.json");
-    let text = serde_json::to_string_pretty(&outcome.summary)
-        .map_err(|e| Error::Scene(format!("cannot serialise the summary: {e}")))?;
-    std::fs::write(&json, text).map_err(|e| Error::io(&json, e))?;
-    let mut files = vec![csv, json];
+pub fn write_outputs(outcome: &RunOutcome, dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut staged = Staged::new(dir)?;
+    outcome.run.history.write_csv(&staged.path("history.csv"))?;
+    staged.write_json("summary.json", &outcome.summary)?;
     if !outcome.run.history.is_empty() {
-        let png = dir.join("history.png");
-        history_figure(outcome).save_png(&png, 1400, 900)?;
-        files.push(png);
+        history_figure(outcome).save_png(&staged.path("history.png"), 1400, 900)?;
     }
-    Ok(files)
+    staged.commit()
 }
 
 /// Time histories of a run: accelerations, slip and roof drift.

@@ -7,6 +7,7 @@ use crate::Result;
 use crate::analytic::ExactResult;
 use crate::dda::SolverParams;
 use crate::ground_motion::GroundMotion;
+use crate::limits::MAX_HISTORY_ROWS;
 use crate::model::Scene;
 use crate::post::history::{History, PeakTracker};
 use crate::post::spectrum::UniformSeries;
@@ -89,7 +90,7 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
     let duration = params.duration;
     let (mut dda, probe) = setup.build_dda(scene, params)?;
     let motion = &setup.motion;
-    let record_every = setup.history.stride();
+    let mut record_every = setup.history.stride();
     let mut peaks = [PeakTracker::default(); 5];
     let mut history = History::new(&HISTORY_COLUMNS);
     let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
@@ -116,6 +117,12 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         series.push(r.time, r.base_accel);
         if record_every > 0 && step.is_multiple_of(record_every) {
             history.push(&row);
+            // Bounded memory: past the limit, every other row goes and the interval
+            // doubles (the kept rows are those of the doubled interval).
+            if history.len() >= MAX_HISTORY_ROWS {
+                history.decimate();
+                record_every *= 2;
+            }
         }
         step += 1;
         last_slip = r.slip;
@@ -231,7 +238,18 @@ pub fn exact_model_run(
     }
 }
 
-/// The exact model of a two-block setup (output every `output_dt` seconds, none if ≤ 0).
+/// The output interval of the exact model: `wanted`, or longer so that a long run keeps
+/// at most [`MAX_HISTORY_ROWS`] rows (0: no output).
+pub fn exact_output_dt(wanted: f64, duration: f64) -> f64 {
+    if wanted > 0.0 {
+        wanted.max(duration / MAX_HISTORY_ROWS as f64)
+    } else {
+        0.0
+    }
+}
+
+/// The exact model of a two-block setup (output every `output_dt` seconds, none if ≤ 0;
+/// longer for long runs, see [`exact_output_dt`]).
 pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
     let (roles, alpha, _) = setup.two_block().ok_or_else(|| {
         crate::Error::invalid(
@@ -246,6 +264,6 @@ pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun>
         setup.friction,
         &setup.motion,
         setup.duration,
-        output_dt,
+        exact_output_dt(output_dt, setup.duration),
     )
 }

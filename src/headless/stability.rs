@@ -16,6 +16,7 @@ use super::simulate::{self, ModelRun};
 use crate::dda::{Dda, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, STANDARD_GRAVITY};
 use crate::model::Scene;
+use crate::post::output::Staged;
 use crate::setup::{ExcitationSpec, Frequency, RunSpec};
 use crate::{Error, Result};
 
@@ -844,17 +845,10 @@ pub fn run_stability(include_slow: bool, tick: &dyn Fn(&StabilityRow)) -> Vec<St
 
 /// Writes `stability.csv` and `report.md` into `out`.
 pub fn write_stability(rows: &[StabilityRow], out: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let csv_path = out.join("stability.csv");
-    let csv_error = |e: csv::Error| Error::Scene(format!("{}: {e}", csv_path.display()));
-    let mut w = csv::Writer::from_path(&csv_path).map_err(csv_error)?;
-    for r in rows {
-        w.serialize(r).map_err(csv_error)?;
-    }
-    w.flush().map_err(|e| Error::io(&csv_path, e))?;
-    let md = out.join("report.md");
-    std::fs::write(&md, report_markdown(rows)).map_err(|e| Error::io(&md, e))?;
-    Ok(vec![csv_path, md])
+    let mut staged = Staged::new(out)?;
+    staged.write_csv("stability.csv", rows)?;
+    staged.write("report.md", report_markdown(rows))?;
+    staged.commit()
 }
 
 /// The report table: one row per case.

@@ -8,11 +8,13 @@
 //! the warnings. The responses themselves (slip, drift, base and roof acceleration) are
 //! defined once, in [`response`].
 
+mod check;
 pub mod defaults;
 mod prepare;
 pub mod response;
 mod spec;
 
+pub use check::{check_steps, exact_steps_for};
 pub use prepare::{RunSetup, SceneRoles};
 pub use response::{Probe, Response};
 pub use spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneSource};

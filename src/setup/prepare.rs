@@ -3,9 +3,9 @@
 
 use std::sync::Arc;
 
-use super::defaults;
 use super::response::Probe;
 use super::spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
+use super::{check, defaults};
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
@@ -63,22 +63,19 @@ pub struct RunSetup {
     pub excitation_label: String,
     /// Things the user should know about the run (resolution, applicability).
     pub warnings: Vec<String>,
+    /// The user confirmed a run beyond the step limit (`--confirm-large`).
+    pub confirm_large: bool,
 }
 
 impl RunSpec {
     /// Checks the specification against its scene and builds the run. Nothing is solved
     /// yet; every error a run can see before it starts is reported here.
     pub fn prepare(&self) -> Result<RunSetup> {
+        check::check_ranges(self)?;
         let scene = self.scene.load()?;
-        let dt = match self.dt {
-            Some(dt) => crate::error::require_positive("--dt", dt)?,
-            None => defaults::DT,
-        };
-        if let Some(d) = self.duration {
-            crate::error::require_positive("--duration", d)?;
-        }
+        check::check_applicable(self, &scene)?;
+        let dt = self.dt.unwrap_or(defaults::DT);
         let integrator = self.integrator.unwrap_or_default();
-        integrator.validate()?;
         let mut setup = if let Some(roles) = scene.two_block.clone() {
             self.two_block(scene, roles)?
         } else if let Some(roles) = scene.structure.clone() {
@@ -112,6 +109,7 @@ impl RunSpec {
         if let Some(kind) = self.ground {
             setup.scene.ground.kind = kind;
         }
+        setup.warnings = check::check_setup(&setup, self.confirm_large)?;
         Ok(setup)
     }
 
@@ -158,6 +156,20 @@ impl RunSpec {
             ),
             _ => (scene_amplitude, scene_ratio),
         };
+        let (lo, hi) = crate::limits::FREQUENCY_RANGE_HZ;
+        let hz = ratio * structure_hz;
+        if record.is_none() && !(ratio.is_finite() && (lo..=hi).contains(&hz)) {
+            return Err(Error::invalid(
+                "--freq-ratio",
+                format!(
+                    "Ω/ω = {} is {} Hz for this structure ({} Hz); the excitation frequency \
+                     must be in [{lo:e}, {hi}] Hz",
+                    crate::error::show(ratio),
+                    crate::error::show(hz),
+                    structure_hz
+                ),
+            ));
+        }
         let params = TwoBlockParams {
             alpha,
             friction,
@@ -223,18 +235,13 @@ impl RunSpec {
             fixed_base: self.fixed_base,
             excitation_label,
             warnings: Vec::new(),
+            confirm_large: self.confirm_large,
         }
     }
 
     /// A building: friction, fixed base and excitation set on the scene as it is.
     fn building(&self, mut scene: Scene, roles: StructureRoles) -> Result<RunSetup> {
         if let Some(f) = self.friction {
-            if f.is_nan() || f < 0.0 {
-                return Err(Error::invalid(
-                    "--friction",
-                    format!("must be >= 0, got {f}"),
-                ));
-            }
             for c in scene.contacts.iter_mut().filter(|c| c.name == roles.joint) {
                 c.friction = f;
             }

@@ -168,6 +168,8 @@ pub struct RunSpec {
     pub integrator: Option<Integrator>,
     /// How much history to keep.
     pub history: HistoryPlan,
+    /// Run even beyond the step limit ([`crate::limits::MAX_STEPS`]).
+    pub confirm_large: bool,
 }
 
 impl Default for SceneSource {
