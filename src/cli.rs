@@ -446,8 +446,9 @@ fn jobs(jobs: Option<usize>) -> Result<usize> {
     }
 }
 
-fn cmd_sweep(args: SweepArgs) -> Result<()> {
-    let req = SweepRequest {
+/// The sweep of `sweep`'s flags.
+fn sweep_request(args: &SweepArgs) -> Result<SweepRequest> {
+    Ok(SweepRequest {
         alphas: parse_list("--alpha", &args.alpha)?,
         frictions: parse_list("--friction", &args.friction)?,
         freq_ratios: parse_ratios("--freq-ratios", &args.freq_ratios)?,
@@ -458,7 +459,11 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
         confirm_large: args.stepping.confirm_large,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: args.shard.as_deref().map(parse_shard).transpose()?,
-    };
+    })
+}
+
+fn cmd_sweep(args: SweepArgs) -> Result<()> {
+    let req = sweep_request(&args)?;
     let threads = jobs(args.jobs)?;
     // Every value and the output folder are checked before the first run.
     req.validate()?;
@@ -563,17 +568,21 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
     write_sweep_outputs(&rows, &args.out)
 }
 
+/// Repeats of a benchmark: `--repeat` when given (also with `--quick`), else 5, or 3
+/// with `--quick`.
+fn bench_repeats(quick: bool, repeat: Option<usize>) -> Result<usize> {
+    use slidebase::limits::MAX_REPEATS;
+    match repeat {
+        None if quick => Ok(3),
+        None => Ok(5),
+        Some(n) if (1..=MAX_REPEATS).contains(&n) => Ok(n),
+        Some(n) => bail!("invalid --repeat: {n}; give 1 to {MAX_REPEATS}"),
+    }
+}
+
 fn cmd_bench(args: BenchArgs) -> Result<()> {
     use slidebase::headless::bench::{BenchOptions, report_text, run_bench, write_bench};
-    let repeats = match args.repeat {
-        None if args.quick => 3,
-        None => 5,
-        Some(n) if (1..=slidebase::limits::MAX_REPEATS).contains(&n) => n,
-        Some(n) => bail!(
-            "invalid --repeat: {n}; give 1 to {}",
-            slidebase::limits::MAX_REPEATS
-        ),
-    };
+    let repeats = bench_repeats(args.quick, args.repeat)?;
     if let Some(dir) = &args.out {
         slidebase::post::output::prepare_dir(dir)?;
     }
@@ -920,4 +929,184 @@ fn cmd_default() -> Result<()> {
     }))?;
     out(&line("wall time (s)", &|s| s.wall_time_s))?;
     out("\nMore: `slidebase run --help`, `slidebase sweep --help`, `slidebase list`.")
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::*;
+    use slidebase::testing::{Rng, property_cases};
+
+    const NUMBERS: &[&str] = &[
+        "0",
+        "-1",
+        "0.5",
+        "0.1",
+        "1",
+        "3",
+        "1e300",
+        "-1e300",
+        "1e-300",
+        "nan",
+        "inf",
+        "-inf",
+        "1e-12",
+        "1e9",
+        "10",
+        "0.01",
+        "0.005",
+        "0.02",
+        "0.2",
+        "x",
+        "",
+        "18446744073709551615",
+    ];
+
+    /// A random `run` or `sweep` command line from the flags' vocabulary.
+    fn command_line(rng: &mut Rng) -> Vec<String> {
+        let sweep = rng.chance(8);
+        let mut args = vec!["slidebase".to_string()];
+        args.push(if sweep { "sweep" } else { "run" }.into());
+        let flags: &[&str] = if sweep {
+            &[
+                "--alpha",
+                "--friction",
+                "--freq-ratios",
+                "--amplitude-g",
+                "--duration",
+                "--dt",
+                "--integrator",
+                "--jobs",
+                "--shard",
+                "--confirm-large",
+            ]
+        } else {
+            &[
+                "--scene",
+                "--alpha",
+                "--friction",
+                "--freq-ratio",
+                "--amplitude-g",
+                "--duration",
+                "--duration",
+                "--dt",
+                "--integrator",
+                "--model",
+                "--fixed-base",
+                "--record",
+                "--ground",
+                "--json",
+                "--confirm-large",
+                "--bogus",
+            ]
+        };
+        for _ in 0..rng.below(6) {
+            let flag = rng.pick(flags);
+            args.push(flag.into());
+            let value = match flag {
+                "--fixed-base" | "--json" | "--confirm-large" => continue,
+                "--scene" => rng.pick(&[
+                    "two-block",
+                    "three-storey",
+                    "frame:2",
+                    "frame:0",
+                    "frame:101",
+                    "wall:2",
+                    "wall:x",
+                    "missing.toml",
+                    "/dev/zero",
+                ]),
+                "--integrator" => rng.pick(&[
+                    "classic",
+                    "trapezoidal",
+                    "hht:0.1",
+                    "hht:5",
+                    "generalized-alpha:0.5",
+                    "gen-alpha:x",
+                    "euler",
+                ]),
+                "--model" => rng.pick(&["dda", "mass-spring", "fem"]),
+                "--record" => rng.pick(&[
+                    "el-centro",
+                    "el-centro-up",
+                    "kobe-nishi-akashi-000",
+                    "/dev/zero",
+                    "missing.AT2",
+                ]),
+                "--ground" => rng.pick(&["prescribed", "large-mass", "x"]),
+                "--freq-ratios" => rng.pick(&["0.1:10:3", "1:1:1", "0:1:2", "0.5,2", "1:10:1e11"]),
+                "--shard" => rng.pick(&["1/2", "0/2", "3/2", "x", "1/18446744073709551615"]),
+                "--jobs" => rng.pick(&["1", "0", "99999", "x"]),
+                "--alpha" | "--friction" if sweep => {
+                    rng.pick(&["0.1,0.5", "0.5", "-1", "inf", "", "x"])
+                }
+                _ => rng.pick(NUMBERS),
+            };
+            args.push(value.into());
+        }
+        args
+    }
+
+    /// Every command line is refused cleanly or prepares a run; the small ones run, and
+    /// their summaries are finite (no `null` in the JSON). In-process: the same code as
+    /// the binary without spawning it ten thousand times.
+    #[test]
+    fn command_lines_are_refused_cleanly_or_run_finitely() {
+        let cases = property_cases();
+        let (mut prepared, mut ran) = (0, 0);
+        for case in 0..cases {
+            let mut rng = Rng::for_case(0xc11, case);
+            let args = command_line(&mut rng);
+            let result = std::panic::catch_unwind(|| -> Result<Option<bool>> {
+                let Ok(cli) = Cli::try_parse_from(&args) else {
+                    return Ok(None);
+                };
+                match cli.command {
+                    Some(Command::Run(a)) => {
+                        let setup = run_spec(&a)?.prepare()?;
+                        let small =
+                            setup.duration / setup.dt <= 100.0 && setup.scene.blocks.len() <= 3;
+                        if !small {
+                            return Ok(Some(false));
+                        }
+                        let json = if setup.two_block().is_some() {
+                            serde_json::to_string(&run_setup(&setup)?.summary)?
+                        } else {
+                            let o = slidebase::headless::frame::run_building_setup(&setup)?;
+                            serde_json::to_string(&o.summary)?
+                        };
+                        assert!(!json.contains("null"), "{args:?}: {json}");
+                        Ok(Some(true))
+                    }
+                    Some(Command::Sweep(a)) => {
+                        let req = sweep_request(&a)?;
+                        jobs(a.jobs)?;
+                        req.validate()?;
+                        Ok(Some(false))
+                    }
+                    _ => Ok(None),
+                }
+            });
+            match result {
+                Err(_) => panic!("case {case} panicked: {args:?}"),
+                Ok(Err(e)) => assert!(!e.to_string().is_empty(), "{args:?}"),
+                Ok(Ok(Some(r))) => {
+                    prepared += 1;
+                    ran += usize::from(r);
+                }
+                Ok(Ok(None)) => {}
+            }
+        }
+        println!("{cases} command lines: {prepared} prepared, {ran} run");
+    }
+
+    #[test]
+    fn repeat_is_honoured_with_quick_and_bounded() {
+        assert_eq!(bench_repeats(true, None).unwrap(), 3);
+        assert_eq!(bench_repeats(true, Some(7)).unwrap(), 7);
+        assert_eq!(bench_repeats(false, None).unwrap(), 5);
+        assert!(bench_repeats(false, Some(0)).is_err());
+        assert!(bench_repeats(false, Some(usize::MAX)).is_err());
+    }
 }

@@ -32,6 +32,7 @@ pub mod post;
 pub mod render;
 pub mod setup;
 pub mod sim;
+pub mod testing;
 #[cfg(feature = "gui")]
 pub mod ui;
 

@@ -666,18 +666,31 @@ fn check_overlaps(scene: &Scene) -> Check {
 }
 
 /// How deep two polygons overlap, if they do by more than a millionth of the smaller one:
-/// a vertex of one inside the other, or edges that cross.
+/// a vertex, edge midpoint or centroid of one inside the other (the midpoints and centroids
+/// catch overlaps whose vertices all lie on the other's edges), or edges that cross.
 fn overlap_depth(a: &[Point], b: &[Point]) -> Option<f64> {
     let tol = 1e-6 * geometry::bounding_size(a).min(geometry::bounding_size(b));
+    let probes = |poly: &[Point]| -> Vec<Point> {
+        let n = poly.len();
+        let mut pts: Vec<Point> = poly.to_vec();
+        pts.extend((0..n).map(|k| {
+            let (p, q) = (poly[k], poly[(k + 1) % n]);
+            [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]
+        }));
+        if let Ok(m) = geometry::moments(poly, "") {
+            pts.push(m.centroid);
+        }
+        pts
+    };
     let inside = |poly: &[Point], p: Point| {
         geometry::contains(poly, p)
             .then(|| geometry::boundary_distance(poly, p))
             .filter(|&d| d > tol)
     };
-    let deepest = a
-        .iter()
-        .filter_map(|&p| inside(b, p))
-        .chain(b.iter().filter_map(|&p| inside(a, p)))
+    let deepest = probes(a)
+        .into_iter()
+        .filter_map(|p| inside(b, p))
+        .chain(probes(b).into_iter().filter_map(|p| inside(a, p)))
         .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))));
     if deepest.is_some() {
         return deepest;

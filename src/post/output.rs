@@ -81,6 +81,14 @@ impl Staged {
 
     /// Moves every written file into place; returns the final paths.
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
+        // A rename onto a folder would fail half-way through: check them all first (a
+        // rename onto a file replaces it whole).
+        if let Some((_, target)) = self.files.iter().find(|(_, t)| t.is_dir()) {
+            return Err(Error::output(
+                target,
+                "is a folder; it cannot be replaced by an output file",
+            ));
+        }
         for (tmp, target) in &self.files {
             std::fs::rename(tmp, target).map_err(|e| Error::io(target, e))?;
         }
