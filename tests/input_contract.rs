@@ -666,3 +666,28 @@ fn a_run_without_outputs_keeps_no_history() {
     h.decimate();
     assert_eq!(h.column("t").unwrap(), &[0.0, 2.0, 4.0]);
 }
+
+#[test]
+fn a_scene_joint_of_infinite_friction_runs_without_null() {
+    let scene = Scene::from_toml(
+        &THREE_STOREY.replace("friction = 0.01", "friction = inf"),
+        "inf.toml",
+    )
+    .unwrap();
+    let o = run_frame(&RunSpec {
+        duration: Some(0.1),
+        ..RunSpec::scene(scene)
+    })
+    .unwrap();
+    let json = serde_json::to_string(&o.summary).unwrap();
+    assert!(
+        !json.contains("null") && !json.contains("\"friction\""),
+        "{json}"
+    );
+    assert!(
+        o.summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("never slides"))
+    );
+}

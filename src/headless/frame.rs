@@ -241,7 +241,7 @@ fn summarise(
         model: model.label().into(),
         integrator: (model == ModelKind::Dda).then(|| setup.integrator.label()),
         record: setup.motion.label(),
-        friction: (!setup.fixed_base).then_some(setup.friction),
+        friction: super::run::reported_friction(setup, &mut warnings),
         fixed_base: setup.fixed_base,
         duration_s: setup.duration,
         max_slip_m: p.slip_m,

@@ -132,7 +132,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         model: setup.model.label().into(),
         integrator: (!exact).then(|| setup.integrator.label()),
         alpha,
-        friction: (!setup.fixed_base).then_some(setup.friction),
+        friction: reported_friction(setup, &mut warnings),
         fixed_base: setup.fixed_base,
         freq_ratio,
         excitation: setup.excitation_label.clone(),
@@ -158,6 +158,23 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
     };
     check_finite(&summary, duration)?;
     Ok(RunOutcome { summary, run })
+}
+
+/// The friction a summary reports: none for a fixed base, and none (with a warning) for a
+/// scene whose joint has `friction = inf`, which JSON cannot carry as a number.
+pub fn reported_friction(setup: &RunSetup, warnings: &mut Vec<String>) -> Option<f64> {
+    if setup.fixed_base {
+        return None;
+    }
+    if setup.friction.is_infinite() {
+        warnings.push(
+            "the sliding joint's friction is inf in the scene: it never slides, as a fixed \
+             base; `friction` is left out"
+                .into(),
+        );
+        return None;
+    }
+    Some(setup.friction)
 }
 
 /// `Some(x)` when x is finite.

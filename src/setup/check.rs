@@ -155,12 +155,15 @@ pub fn exact_steps_for(f_max: f64, motion: &GroundMotion, duration: f64) -> f64 
 /// Refuses a run whose step count is beyond [`MAX_STEPS`] unless confirmed.
 pub fn check_steps(steps: f64, what: &str, confirmed: bool) -> Result<()> {
     if steps > MAX_STEPS && !confirmed {
+        // The fastest model (two blocks) takes about 3e5 steps per second.
+        let hours = steps / 3e5 / 3600.0;
         return Err(Error::invalid(
             "--duration/--dt",
             format!(
                 "{what} would take {steps:.3e} steps, beyond the limit of {MAX_STEPS:e} \
-                 (hours to years of computing); shorten --duration, enlarge --dt, or give \
-                 --confirm-large to run it anyway"
+                 (at least {} h of computing at the two-block model's 3e5 steps/s); \
+                 shorten --duration, enlarge --dt, or give --confirm-large to run it anyway",
+                show(hours)
             ),
         ));
     }

@@ -92,6 +92,9 @@ pub struct PreparedRun {
     /// For two-block scenes: the exact mass-spring solution (time, slip, drift, base accel,
     /// roof accel), for overlaying on the DDA curves.
     pub exact: Option<ExactOverlay>,
+    /// What the user should know about the run (e.g. a time step that barely resolves the
+    /// excitation), from the shared set-up's checks.
+    pub warnings: Vec<String>,
 }
 
 /// The exact mass-spring solution of a two-block run, sampled for plotting.
@@ -165,6 +168,7 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
         duration: setup.duration,
         models,
         exact,
+        warnings: setup.warnings,
     })
 }
 
