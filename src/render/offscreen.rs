@@ -298,9 +298,13 @@ pub fn render_run_png(
     path: &Path,
 ) -> Result<PictureInfo> {
     crate::error::require_non_negative("--time", time)?;
-    let gpu = Gpu::new()?;
+    // The run is checked (and set up) before the graphics adapter is looked for, so that
+    // a bad flag is reported as such on any machine.
     let t0 = std::time::Instant::now();
     let mut run = crate::sim::prepare(config)?;
+    let prepared = t0.elapsed();
+    let gpu = Gpu::new()?;
+    let t0 = std::time::Instant::now() - prepared;
     let time = time.min(run.duration);
     let windows: Vec<[f32; 3]> = run
         .models

@@ -170,14 +170,19 @@ impl Extractor {
                 }
             })
             .collect();
-        let slip = dda.displacement_relative_to_ground(self.base);
+        // Slip, drift and the accelerations as every front end defines them.
+        let r = crate::setup::Probe {
+            base: self.base,
+            roof: self.roof,
+        }
+        .measure(dda, motion);
         let probes = Probes {
-            ground_accel: motion.map_or(0.0, |m| m.accel(t)),
-            ground_disp: dda.frame_displacement(),
-            base_accel: dda.absolute_accel(self.base),
-            roof_accel: dda.absolute_accel(self.roof),
-            slip,
-            drift: dda.displacement_relative_to_ground(self.roof) - slip,
+            ground_accel: r.ground_accel,
+            ground_disp: r.ground_disp,
+            base_accel: r.base_accel,
+            roof_accel: r.roof_accel,
+            slip: r.slip,
+            drift: r.drift,
             joint_force,
             energy: dda.energy(),
         };
