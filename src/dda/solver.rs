@@ -171,6 +171,9 @@ pub struct Dda {
     last_landing: f64,
     /// The states contacts take at the event a shortened step is landed on.
     pending_events: Vec<(contact::ContactKey, ContactState)>,
+    /// The stored accelerations are not yet those of the forces (a model that starts
+    /// out of equilibrium): the first event resolution computes them.
+    initial_accel_pending: bool,
 }
 
 /// xᵀ M y for a block's 6×6 matrix.
@@ -420,6 +423,7 @@ impl Dda {
             restart: Restart::None,
             last_landing: f64::NEG_INFINITY,
             pending_events: Vec::new(),
+            initial_accel_pending: false,
         };
         model.check_initial_overlap()?;
         if model.params.initial_equilibrium {
@@ -428,6 +432,7 @@ impl Dda {
             // The stored accelerations (zero) are not those of the initial forces: the
             // first step restarts, so that it does not depend on them.
             model.restart = Restart::Event;
+            model.initial_accel_pending = true;
         }
         model.reset_reference();
         Ok(model)
@@ -642,7 +647,9 @@ impl Dda {
     /// frame that translates with the input ground motion (every block feels −m ü0), so
     /// absolute positions are the blocks' plus this.
     pub fn frame_displacement(&self) -> f64 {
-        self.motion.as_ref().map_or(0.0, |m| m.displacement(self.time))
+        self.motion
+            .as_ref()
+            .map_or(0.0, |m| m.displacement(self.time))
     }
 
     /// Ground acceleration at time t (the input, not the large-mass ground's response).
@@ -1127,7 +1134,9 @@ impl Dda {
         self.add_contacts(&mut sys, known, mode);
         self.hold_rigid_strains(&mut sys);
         let structure = self.structure_key(mode);
-        let solved = self.linear.solve(&sys.k, sys.r.as_slice(), structure, solution);
+        let solved = self
+            .linear
+            .solve(&sys.k, sys.r.as_slice(), structure, solution);
         let result = solved.map_err(|e| self.solve_error(e)).and_then(|()| {
             let mut increments = self.increments(solution, known);
             if !self.augmented() {
@@ -1537,7 +1546,16 @@ impl Dda {
             .collect();
         // The tangential force each contact carried before the event (on the vertex,
         // along t̂): a sliding contact's friction, a stuck one's multiplier.
-        let forces_before: Vec<f64> = self.contacts.iter().map(|c| c.start_shear_multiplier).collect();
+        let forces_before: Vec<f64> = self
+            .contacts
+            .iter()
+            .map(|c| c.start_shear_multiplier)
+            .collect();
+        let initial_forces = if self.initial_accel_pending {
+            self.out_of_balance_forces()
+        } else {
+            Vec::new()
+        };
         for _ in 0..=MAX_FLIPS_PER_STEP {
             for (b, saved) in self.blocks.iter_mut().zip(&before) {
                 [b.velocity, b.accel, b.response_accel] = *saved;
@@ -1548,13 +1566,21 @@ impl Dda {
             for (c, &old) in self.contacts.iter().zip(&forces_before) {
                 if let ContactState::Sliding { direction } = c.start_state {
                     let change = -direction * c.props.friction.min(1e30) * c.start_normal - old;
-                    for (blk, grad) in [(c.key.vertex_block, &c.slip_i), (c.key.edge_block, &c.slip_j)] {
+                    for (blk, grad) in [
+                        (c.key.vertex_block, &c.slip_i),
+                        (c.key.edge_block, &c.slip_j),
+                    ] {
                         if let Some(s) = self.dofs.slot[blk] {
                             for k in 0..6 {
                                 friction_change[s + k] += change * grad[k];
                             }
                         }
                     }
+                }
+            }
+            if self.initial_accel_pending {
+                for (f, r) in friction_change.iter_mut().zip(&initial_forces) {
+                    *f += r;
                 }
             }
             self.hold_rigid_change(&mut friction_change);
@@ -1610,7 +1636,27 @@ impl Dda {
             }
         }
         self.energy.impact_dissipated += kinetic_before - self.kinetic_energy();
+        self.initial_accel_pending = false;
         Ok(())
+    }
+
+    /// The forces not in balance at the current state (loads, gravity, the ground's
+    /// body force, less the internal forces), per degree of freedom; with the stored
+    /// velocities they give the initial accelerations of a model released out of
+    /// equilibrium.
+    fn out_of_balance_forces(&self) -> Vec<f64> {
+        let mode = Mode::Static { friction: None };
+        let known = self.known_increments(mode);
+        let sys = self.assemble_base(mode, &known, &self.element_terms());
+        let mut forces: Vec<f64> = sys.r.iter().copied().collect();
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if let Some(s) = self.dofs.slot[bi]
+                && b.role != BlockRole::LargeMassGround
+            {
+                forces[s] -= b.total_mass() * self.ground_accel(self.time);
+            }
+        }
+        forces
     }
 
     /// Projects the velocities or accelerations of the free blocks onto the constraints
@@ -1623,7 +1669,7 @@ impl Dda {
     /// accelerations the force changes the event makes besides the constraints'.
     fn project(&mut self, field: Field, extra: Option<&[f64]>) -> Result<Vec<[f64; 2]>> {
         let mut multipliers = vec![[0.0_f64; 2]; self.contacts.len()];
-        if !self.contacts.iter().any(|c| c.start_state.is_closed()) {
+        if extra.is_none() && !self.contacts.iter().any(|c| c.start_state.is_closed()) {
             return Ok(multipliers);
         }
         let mass_factor = 1.0 / (self.coeffs.beta * self.params.dt * self.params.dt);
@@ -1653,10 +1699,24 @@ impl Dda {
                 let p = c.props.normal_penalty / mass_factor;
                 let (i, j) = (c.key.vertex_block, c.key.edge_block);
                 if c.start_state.is_closed() {
-                    sys.add_scalar_spring(&self.dofs, &still, p, -m[0], (i, &c.gap_i), Some((j, &c.gap_j)));
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        &still,
+                        p,
+                        -m[0],
+                        (i, &c.gap_i),
+                        Some((j, &c.gap_j)),
+                    );
                 }
                 if c.start_state == ContactState::Locked {
-                    sys.add_scalar_spring(&self.dofs, &still, p, -m[1], (i, &c.slip_i), Some((j, &c.slip_j)));
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        &still,
+                        p,
+                        -m[1],
+                        (i, &c.slip_i),
+                        Some((j, &c.slip_j)),
+                    );
                 }
             }
             self.hold_rigid_strains(&mut sys);
@@ -1667,7 +1727,9 @@ impl Dda {
             let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
             for (c, m) in self.contacts.iter().zip(multipliers.iter_mut()) {
                 let p = c.props.normal_penalty / mass_factor;
-                let rate = |a: &Vec6, b: &Vec6| dot6(a, &x[c.key.vertex_block]) + dot6(b, &x[c.key.edge_block]);
+                let rate = |a: &Vec6, b: &Vec6| {
+                    dot6(a, &x[c.key.vertex_block]) + dot6(b, &x[c.key.edge_block])
+                };
                 // Force (normal: pushing apart; shear: on the vertex along t̂) that the
                 // constraint takes: λ ← λ − p·g, as for the step's contacts.
                 if c.start_state.is_closed() {
@@ -1709,6 +1771,10 @@ impl Dda {
         // The step after a landing on a contact event restarts the integrator (see
         // [`Restart`]).
         let scheme = self.coeffs;
+        // An event at the very start of a step asks once for a restart; a second request
+        // in the same step (restarts disabled, or the restart found the same event) is
+        // taken as it comes, so a step always ends.
+        let mut may_restart = self.params.restart_after_events;
         loop {
             let restart = if self.params.restart_after_events {
                 self.restart
@@ -1739,12 +1805,12 @@ impl Dda {
                     }
                 }
             }
-            let result = self.step_with_current_scheme(max_dt, restart);
+            let result = self.step_with_current_scheme(max_dt, restart, may_restart);
             self.coeffs = scheme;
             match result {
                 Ok(Some(report)) => return Ok(report),
                 // An event right at the step start: redo the step as a restart.
-                Ok(None) => continue,
+                Ok(None) => may_restart = false,
                 Err(e) => return Err(e),
             }
         }
@@ -1752,11 +1818,12 @@ impl Dda {
 
     /// One step with the current coefficients (`restart` says how this step restarts the
     /// integrator); `Ok(None)` asks for a restart (an event at the very start of the step
-    /// was found).
+    /// was found; only when `may_restart`).
     fn step_with_current_scheme(
         &mut self,
         max_dt: f64,
         restart: Restart,
+        may_restart: bool,
     ) -> Result<Option<StepReport>> {
         let mut cuts = 0;
         let dt_min = self.params.dt * self.params.min_dt_fraction;
@@ -1802,7 +1869,7 @@ impl Dda {
                     Restart::Event
                 };
                 let at_start = theta * dt <= 1e-6 * self.params.dt;
-                if at_start && restart == Restart::None {
+                if at_start && restart == Restart::None && may_restart {
                     // The event happened at the step start: restart from here.
                     self.restart = event_kind;
                     if self.augmented() {
@@ -1815,7 +1882,13 @@ impl Dda {
                     dt_override = Some(theta * dt);
                     if std::env::var("DBG").is_ok() {
                         for c in &self.contacts {
-                            eprintln!("land theta {theta} {:?}->{:?} ef {} {}", c.start_state, c.state, c.event_fraction_in_step(), c.event_fraction);
+                            eprintln!(
+                                "land theta {theta} {:?}->{:?} ef {} {}",
+                                c.start_state,
+                                c.state,
+                                c.event_fraction_in_step(),
+                                c.event_fraction
+                            );
                         }
                     }
                     // The states the contacts take at the event: given to them when the

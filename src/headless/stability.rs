@@ -495,7 +495,8 @@ fn density_case(case: &str, factor: f64) -> StabilityRow {
 
 /// A single rectangular block (half-width `b`, half-height `h`) on a long ground, tilted
 /// clockwise by `tilt` about its bottom-right corner and lifted by `lift`.
-fn single_block_scene(b: f64, h: f64, tilt: f64, lift: f64, friction: f64) -> Result<Scene> {
+/// (Public for probes.)
+pub fn single_block_scene(b: f64, h: f64, tilt: f64, lift: f64, friction: f64) -> Result<Scene> {
     let (s, c) = (-tilt).sin_cos();
     let corner = |x: f64, y: f64| {
         let (dx, dy) = (x - b, y);
@@ -665,9 +666,10 @@ fn overturning(case: &str) -> StabilityRow {
                 ok,
                 format!(
                     "final rotation {rotation:.4} rad, spin {spin:.1e} rad/s, impact loss {:.0} J \
-                     of {:.0} J input",
+                     of {:.0} J input, energy residual {residual:.1e}, penetration {:.1e}",
                     e.impact_dissipated,
-                    e.input_work + e.external_work
+                    e.input_work + e.external_work,
+                    dda.counters().max_penetration_ratio
                 ),
             )
         }

@@ -133,7 +133,12 @@ impl Extractor {
                 let (s, co) = b.rotation.sin_cos();
                 let rigid = self.offsets[i]
                     .iter()
-                    .map(|o| self.local([c[0] + co * o[0] - s * o[1], c[1] + s * o[0] + co * o[1]], shift))
+                    .map(|o| {
+                        self.local(
+                            [c[0] + co * o[0] - s * o[1], c[1] + s * o[0] + co * o[1]],
+                            shift,
+                        )
+                    })
                     .collect();
                 let r = &self.reference_strain[i];
                 BlockFrame {
@@ -193,7 +198,12 @@ impl Extractor {
             bolts: dda
                 .bolts()
                 .iter()
-                .map(|b| [self.local(b.points[0], shift), self.local(b.points[1], shift)])
+                .map(|b| {
+                    [
+                        self.local(b.points[0], shift),
+                        self.local(b.points[1], shift),
+                    ]
+                })
                 .collect(),
             connections: dda
                 .connections()
@@ -204,4 +214,3 @@ impl Extractor {
         }
     }
 }
-
