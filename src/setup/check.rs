@@ -161,9 +161,8 @@ pub fn check_steps(steps: f64, what: &str, confirmed: bool) -> Result<()> {
             "--duration/--dt",
             format!(
                 "{what} would take {steps:.3e} steps, beyond the limit of {MAX_STEPS:e} \
-                 (at least {} h of computing at the two-block model's 3e5 steps/s); \
-                 shorten --duration, enlarge --dt, or give --confirm-large to run it anyway",
-                show(hours)
+                 (at least {hours:.1} h of computing at the two-block model's 3e5 steps/s); \
+                 shorten --duration, enlarge --dt, or give --confirm-large to run it anyway"
             ),
         ));
     }
