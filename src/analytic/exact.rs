@@ -663,15 +663,16 @@ pub fn simulate(
                     });
                 }
             }
+            // At a switch the slip velocity is zero (a slip stops, or starts from rest).
+            // It must be set so even when the phase does not change (a slip that stops
+            // and at once slides on the same way): left at the root's tiny residual,
+            // possibly against the slip direction, the switching function would already
+            // be positive at the next step's start, no crossing would ever be found, and
+            // friction would push the raft along for the rest of the run.
+            end.v_s = 0.0;
             if next != end.phase {
                 // Peaks on the old side of the switch are counted; now the new side.
                 end.phase = next;
-                if next == Phase::Stick {
-                    end.v_s = 0.0;
-                }
-                if let Phase::Slip { .. } = next {
-                    end.v_s = 0.0;
-                }
                 offer_peaks(&solver, &mut peaks, &end);
                 if result.events.len() < opts.max_events {
                     result.events.push(PhaseEvent {
