@@ -154,7 +154,7 @@ pub fn write_data(state: &AppState, dir: &Path) -> Result<Vec<PathBuf>> {
         state.play_time,
         state.view.spectrum_to_cursor,
     );
-    crate::ui::write_plot_data(dir, &state.timeline, state.play_time, &data)?;
+    crate::ui::write_plot_data(dir, &state.timeline, &data)?;
     Ok(vec![dir.join("series.csv"), dir.join("spectrum.csv")])
 }
 
@@ -198,7 +198,7 @@ pub fn ffmpeg_available() -> bool {
 pub fn frame_times(from: f64, to: f64, fps: f64) -> Result<Vec<f64>> {
     crate::error::require_non_negative("--from", from)?;
     crate::error::require_positive("--fps", fps)?;
-    if !(to > from) {
+    if to.is_nan() || to <= from {
         return Err(Error::invalid(
             "--to",
             format!("must be after --from ({from} s), got {to} s"),

@@ -57,11 +57,11 @@ fn synthetic(generation: u64, duration: f64, upto: f64) -> Vec<SimMessage> {
         for k in 0..=2 * n {
             let t = k as f64 * 0.005;
             s.time.push(t);
-            s.ground_accel.push((6.28 * t).sin());
-            s.base_accel.push(0.5 * (6.28 * t).sin());
-            s.roof_accel.push(0.4 * (6.28 * t).sin());
+            s.ground_accel.push((std::f64::consts::TAU * t).sin());
+            s.base_accel.push(0.5 * (std::f64::consts::TAU * t).sin());
+            s.roof_accel.push(0.4 * (std::f64::consts::TAU * t).sin());
             s.slip.push(0.1 * t);
-            s.drift.push(0.01 * (6.28 * t).sin());
+            s.drift.push(0.01 * (std::f64::consts::TAU * t).sin());
         }
     }
     let mut msgs = vec![
@@ -367,13 +367,13 @@ fn plot_data_export_writes_well_formed_csv() {
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
-    // Up to the cursor (1 s) at the samples' 5 ms: 201 rows of 2 + 2 × 4 columns.
-    assert_eq!(rows.len(), 201);
+    // Everything computed (2 s) at the samples' 5 ms: 401 rows of 2 + 2 × 4 columns.
+    assert_eq!(rows.len(), 401);
     assert!(
         rows.iter()
             .all(|r| r.len() == 10 && r.iter().all(|v| v.is_finite()))
     );
-    assert!((rows[200][0] - 1.0).abs() < 1e-9);
+    assert!((rows[400][0] - 2.0).abs() < 1e-9);
     let mut spectrum = csv::Reader::from_path(dir.path().join("spectrum.csv")).unwrap();
     let names: Vec<String> = spectrum
         .headers()

@@ -378,7 +378,7 @@ pub fn exaggerate(rigid: [f32; 2], actual: [f32; 2], f: f32) -> [f32; 2] {
 
 /// A spacing of `1, 2 or 5 × 10ⁿ` metres at least `min` long (ticks, scale bars).
 pub fn nice_step(min: f32) -> f32 {
-    if !(min > 0.0) || !min.is_finite() {
+    if min.is_nan() || min <= 0.0 || !min.is_finite() {
         return 1.0;
     }
     let p = 10f32.powf(min.log10().floor());
@@ -458,7 +458,10 @@ fn draw_panel(p: &mut Painter<'_>, panel: &PanelView<'_>, view: &SceneView<'_>) 
             .map(|(r, a)| exaggerate(*r, *a, factor))
             .collect();
         if view.layers.blocks {
+            // The close-up is about positions, not strain: plain blocks let the ghost and
+            // the slip arrow stand out.
             let color = match view.color_by {
+                _ if panel.close_up => MATERIAL,
                 ColorBy::Material => MATERIAL,
                 c => colormap(
                     color_measure(c, &blk.stress, &blk.strain)

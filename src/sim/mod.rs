@@ -144,7 +144,7 @@ impl MotionInfo {
 fn scale_to_pga(motion: GroundMotion, pga_g: f64, duration: f64) -> Result<(GroundMotion, f64)> {
     crate::error::require_positive("PGA", pga_g)?;
     let peak = motion.peak_accel(duration) / crate::ground_motion::STANDARD_GRAVITY;
-    if !(peak > 0.0) {
+    if peak.is_nan() || peak <= 0.0 {
         return Err(Error::invalid(
             "PGA",
             "the ground motion is zero; there is nothing to scale",

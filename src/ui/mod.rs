@@ -338,6 +338,7 @@ pub struct AppState {
     /// The preset last chosen (its name), until the controls change.
     pub preset: Option<&'static str>,
     fits: Option<(u64, usize, f32, Vec<Fit>)>,
+    laid_out: bool,
     outbox: Vec<SimCommand>,
     requests: Vec<ShellRequest>,
 }
@@ -370,6 +371,7 @@ impl AppState {
             widget_rects: Default::default(),
             preset: None,
             fits: None,
+            laid_out: false,
             outbox: Vec::new(),
             requests: Vec::new(),
         };
@@ -588,6 +590,13 @@ impl AppState {
 
     /// Draws the whole UI.
     pub fn ui(&mut self, ui: &mut egui::Ui) {
+        if !self.laid_out {
+            // A small window starts with the controls folded away: the scene needs the room.
+            self.laid_out = true;
+            if ui.ctx().content_rect().width() < 1280.0 {
+                self.view.show_controls = false;
+            }
+        }
         self.keyboard(ui.ctx());
         let full = self.view.full_screen;
         if !full {
@@ -763,7 +772,7 @@ pub fn auto_exaggeration(timeline: &Timeline) -> f32 {
     let drift = (0..timeline.samples.len())
         .map(|m| timeline.peak(m, f64::INFINITY, |s| &s.drift))
         .fold(0.0f64, f64::max) as f32;
-    if !(drift > 0.0) {
+    if drift.is_nan() || drift <= 0.0 {
         return 50.0;
     }
     let raw = (0.08 * height / drift).clamp(1.0, 1000.0);

@@ -123,15 +123,15 @@ fn curve(name: String, points: Vec<[f64; 2]>, color: Option<egui::Color32>) -> C
 }
 
 impl PlotData {
-    /// The curves for the run in `state`, up to the time cursor for the histories; the
-    /// spectra up to the cursor or over everything computed (`to_cursor`).
+    /// The curves of everything computed in `timeline` (the plots mark the cursor with a
+    /// line); the spectra over everything computed or only up to `cursor` (`to_cursor`).
     pub fn of(timeline: &super::Timeline, cursor: f64, to_cursor: bool) -> Self {
         let labels = &timeline.labels;
         let mut d = PlotData::default();
         let Some(main) = timeline.samples.first() else {
             return d;
         };
-        let upto = |s: &Samples| s.count_until(cursor);
+        let upto = |s: &Samples| s.len();
         let n0 = upto(main);
         d.accel.push(curve(
             "ground".into(),
@@ -160,7 +160,8 @@ impl PlotData {
             ));
         }
         if let Some(e) = &timeline.exact {
-            let n = e.time.partition_point(|&t| t <= cursor + 1e-9);
+            let computed = timeline.available();
+            let n = e.time.partition_point(|&t| t <= computed + 1e-9);
             let series = |y: &[f64], scale: f64| -> Vec<[f64; 2]> {
                 e.time[..n]
                     .iter()
@@ -228,13 +229,29 @@ fn tick(value: f64, step: f64) -> String {
     format!("{value:.decimals$}")
 }
 
+/// Grid lines at 1, 2 or 5 × 10ⁿ, about `lines` across the visible range (the default
+/// powers of ten left a range of ±0.8 with a single "0" label).
+fn nice_grid(lines: f64) -> impl Fn(egui_plot::GridInput) -> Vec<egui_plot::GridMark> {
+    egui_plot::uniform_grid_spacer(move |input| {
+        let range = (input.bounds.1 - input.bounds.0).abs().max(1e-12);
+        let raw = range / lines;
+        let p = 10f64.powf(raw.log10().floor());
+        let step = [1.0, 2.0, 5.0, 10.0]
+            .into_iter()
+            .map(|m| m * p)
+            .find(|&s| s >= raw)
+            .unwrap_or(10.0 * p);
+        [step / 5.0, step, 5.0 * step]
+    })
+}
+
 /// Draws one plot: legend row, the plot with units, the cursor line, a hover readout.
 fn plot(
     ui: &mut egui::Ui,
     id: &str,
     curves: &[Curve],
     units: (&str, &str),
-    cursor: Option<f64>,
+    cursor: Option<(f64, f64)>,
     peak_fmt: &dyn Fn(&Curve) -> String,
     height: f32,
 ) {
@@ -267,6 +284,8 @@ fn plot(
         .x_axis_label(x_unit.clone())
         .y_axis_label(y_unit.clone())
         .y_axis_min_width(44.0)
+        .x_grid_spacer(nice_grid(6.0))
+        .y_grid_spacer(nice_grid(4.0))
         .x_axis_formatter(|m, _| tick(m.value, m.step_size))
         .y_axis_formatter(|m, _| tick(m.value, m.step_size))
         .label_formatter(|_| None)
@@ -277,6 +296,8 @@ fn plot(
         .allow_drag(false)
         .allow_boxed_zoom(false)
         .auto_bounds(true)
+        .include_x(0.0)
+        .include_x(cursor.map_or(0.0, |c| c.1))
         .show(ui, |p| {
             for c in curves {
                 let mut line = Line::new(c.name.clone(), PlotPoints::new(c.points.clone()))
@@ -287,7 +308,7 @@ fn plot(
                 }
                 p.line(line);
             }
-            if let Some(t) = cursor {
+            if let Some((t, _)) = cursor {
                 p.vline(
                     VLine::new("time cursor", t)
                         .color(egui::Color32::GRAY)
@@ -330,6 +351,7 @@ fn value_at(points: &[[f64; 2]], x: f64) -> Option<f64> {
 pub fn plots_ui(state: &mut AppState, ui: &mut egui::Ui) {
     let t = state.play_time;
     let data = PlotData::of(&state.timeline, t, state.view.spectrum_to_cursor);
+    let cursor = Some((t, state.timeline.duration));
     let height = (ui.available_height() / 4.5).clamp(110.0, 220.0);
     let peak_g = |c: &Curve| format!("(peak {:.3})", c.peak);
     let peak_m = |c: &Curve| format!("(peak {})", crate::post::format_number(c.peak));
@@ -341,7 +363,7 @@ pub fn plots_ui(state: &mut AppState, ui: &mut egui::Ui) {
                 "accel",
                 &data.accel,
                 ("s", "g"),
-                Some(t),
+                cursor,
                 &peak_g,
                 height,
             )
@@ -349,7 +371,7 @@ pub fn plots_ui(state: &mut AppState, ui: &mut egui::Ui) {
     egui::CollapsingHeader::new("slip of the base")
         .default_open(true)
         .show(ui, |ui| {
-            plot(ui, "slip", &data.slip, ("s", "m"), Some(t), &peak_m, height)
+            plot(ui, "slip", &data.slip, ("s", "m"), cursor, &peak_m, height)
         });
     egui::CollapsingHeader::new("roof drift (relative to the base)")
         .default_open(true)
@@ -359,7 +381,7 @@ pub fn plots_ui(state: &mut AppState, ui: &mut egui::Ui) {
                 "drift",
                 &data.drift,
                 ("s", "m"),
-                Some(t),
+                cursor,
                 &peak_m,
                 height,
             )
@@ -488,7 +510,7 @@ fn energy(state: &AppState, ui: &mut egui::Ui, height: f32) {
             &format!("energy{m}"),
             &curves,
             ("s", "kJ/m"),
-            Some(t),
+            Some((t, state.timeline.duration)),
             &peak,
             height,
         );
@@ -500,7 +522,7 @@ impl AppState {
     pub fn export_data(&mut self) {
         let dir = std::path::PathBuf::from(&self.export_dir);
         let data = PlotData::of(&self.timeline, self.play_time, self.view.spectrum_to_cursor);
-        match write_plot_data(&dir, &self.timeline, self.play_time, &data) {
+        match write_plot_data(&dir, &self.timeline, &data) {
             Ok(()) => self.say(format!(
                 "wrote series.csv and spectrum.csv to {}",
                 dir.display()
@@ -510,21 +532,20 @@ impl AppState {
     }
 }
 
-/// Writes `series.csv` (full-rate time histories up to `cursor`: time, ground acceleration,
+/// Writes `series.csv` (the full-rate time histories computed: time, ground acceleration,
 /// and per model roof and base acceleration, slip and drift, named by model) and
 /// `spectrum.csv` (`frequency_hz`, then one column per spectrum curve, named as in the
 /// legend) into `dir`.
 pub fn write_plot_data(
     dir: &std::path::Path,
     timeline: &super::Timeline,
-    cursor: f64,
     data: &PlotData,
 ) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
     let mut header = vec!["time_s".to_string(), "ground_accel_g".to_string()];
     let mut columns: Vec<Vec<f64>> = Vec::new();
     let main = timeline.samples.first();
-    let n = main.map_or(0, |s| s.count_until(cursor));
+    let n = main.map_or(0, Samples::len);
     if let Some(s) = main {
         columns.push(s.time[..n].to_vec());
         columns.push(s.ground_accel[..n].iter().map(|a| a / G).collect());

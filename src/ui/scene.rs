@@ -555,7 +555,7 @@ pub fn scene_ui(state: &mut AppState, ui: &mut egui::Ui) {
                 egui::pos2(c.main[0], c.main[1]),
                 egui::vec2(c.main[2], c.main[3]),
             );
-            r.contains(pos).then(|| (r, *v, pos))
+            r.contains(pos).then_some((r, *v, pos))
         })
     });
     if let Some((r, view, pos)) = hovered_panel {
