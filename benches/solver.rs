@@ -11,9 +11,9 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use slidebase::dda::{Dda, SolverParams};
 use slidebase::ground_motion::{GroundMotion, resolve_record};
-use slidebase::headless::run::{RunRequest, run};
-use slidebase::headless::two_block::ModelKind;
+use slidebase::headless::run::run;
 use slidebase::model::presets::resolve_scene;
+use slidebase::setup::{ModelKind, RunSpec};
 
 fn two_block(c: &mut Criterion) {
     let mut group = c.benchmark_group("two-block");
@@ -24,11 +24,10 @@ fn two_block(c: &mut Criterion) {
         ("dda 10 s", ModelKind::Dda),
         ("exact 10 s", ModelKind::MassSpring),
     ] {
-        let req = RunRequest {
+        let req = RunSpec {
             duration: Some(10.0),
-            record_every: 0,
             model,
-            ..RunRequest::default()
+            ..RunSpec::default()
         };
         group.bench_function(name, |b| {
             b.iter(|| black_box(run(&req).map(|o| o.summary.us_max_over_d)))

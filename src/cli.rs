@@ -1,17 +1,18 @@
 //! Command-line definitions (clap) and the glue from flags to the headless functions.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use slidebase::dda::Integrator;
-use slidebase::headless::run::{RunRequest, run, write_outputs};
+use slidebase::headless::run::{OUTPUT_HISTORY, run_setup, write_outputs};
 use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, parse_shard, run_sweep};
-use slidebase::headless::two_block::ModelKind;
 use slidebase::model::scene::GroundKind;
+use slidebase::post::output::Staged;
+use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 
 /// Buildings on a sliding (friction) base under earthquakes, computed with Discontinuous
 /// Deformation Analysis and checked against the exact mass-spring solution.
@@ -76,41 +77,40 @@ struct RunArgs {
     /// Built-in scene name or a scene TOML file.
     #[arg(long, default_value = "two-block")]
     scene: String,
-    /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1) (two-block; default 0.5).
+    /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1) (two-block scenes;
+    /// default: the scene's, 0.5).
     #[arg(long, allow_hyphen_values = true)]
     alpha: Option<f64>,
-    /// Friction coefficient ρ of the sliding joint, ≥ 0 (default: 0.1 two-block, the scene's otherwise).
+    /// Friction coefficient ρ of the sliding joint, in [0, 1000] (default: the scene's).
     #[arg(long, allow_hyphen_values = true)]
     friction: Option<f64>,
-    /// Excitation frequency over the structure frequency, Ω/ω (two-block; default 1).
-    #[arg(long = "freq-ratio", allow_hyphen_values = true)]
+    /// Excitation frequency over the structure frequency, Ω/ω (two-block scenes; default:
+    /// the scene's, 1).
+    #[arg(
+        long = "freq-ratio",
+        allow_hyphen_values = true,
+        conflicts_with = "record"
+    )]
     freq_ratio: Option<f64>,
-    /// Amplitude of the harmonic ground acceleration, g.
+    /// Amplitude of the harmonic ground acceleration, g (default: the scene's, 0.3).
     #[arg(
         long = "amplitude-g",
-        default_value_t = 0.3,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        conflicts_with = "record"
     )]
-    amplitude_g: f64,
-    /// Duration, s (default: 100 s for harmonic input, the record's length for a record).
-    #[arg(long, allow_hyphen_values = true)]
-    duration: Option<f64>,
-    /// Time step, s.
-    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
-    dt: f64,
-    /// classic | trapezoidal | hht[:α] | generalized-alpha[:ρ∞].
-    #[arg(long, default_value = "generalized-alpha")]
-    integrator: String,
+    amplitude_g: Option<f64>,
+    #[command(flatten)]
+    stepping: Stepping,
     /// Which model computes the response.
     #[arg(long, value_enum, default_value = "dda")]
     model: ModelArg,
     /// Fix the base: the sliding joint never slides.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "friction")]
     fixed_base: bool,
     /// Ground-motion record (built-in name or AT2/CSV file) instead of harmonic input.
     #[arg(long)]
     record: Option<String>,
-    /// Ground model of the DDA run.
+    /// Ground model of the DDA run (default: the scene's).
     #[arg(long, value_enum)]
     ground: Option<GroundArg>,
     /// Write time histories (CSV) and the summary (JSON) into this folder.
@@ -119,6 +119,36 @@ struct RunArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     json: bool,
+}
+
+/// The time stepping of runs (`run` and `sweep`).
+#[derive(Debug, clap::Args)]
+struct Stepping {
+    /// Duration of a run, s (default: 100 s for harmonic input, the record's length for a
+    /// record).
+    #[arg(long, allow_hyphen_values = true)]
+    duration: Option<f64>,
+    /// Time step of the DDA model, s (default 1e-3).
+    #[arg(long, allow_hyphen_values = true)]
+    dt: Option<f64>,
+    /// DDA integrator: classic | trapezoidal | hht[:α] | generalized-alpha[:ρ∞] (default
+    /// generalized-alpha:0).
+    #[arg(long)]
+    integrator: Option<String>,
+    /// Run even if a run is larger than the limit of 1e8 steps.
+    #[arg(long)]
+    confirm_large: bool,
+}
+
+impl Stepping {
+    /// The integrator, parsed.
+    fn integrator(&self) -> Result<Option<Integrator>> {
+        Ok(self
+            .integrator
+            .as_deref()
+            .map(Integrator::parse)
+            .transpose()?)
+    }
 }
 
 #[derive(Debug, clap::Args)]
@@ -204,15 +234,18 @@ struct ReportArgs {
     /// Friction coefficient of the sliding joint (default: the scene's, 0.01).
     #[arg(long, allow_hyphen_values = true)]
     friction: Option<f64>,
-    /// Time step, s.
-    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
-    dt: f64,
+    /// Time step, s (default 1e-3).
+    #[arg(long, allow_hyphen_values = true)]
+    dt: Option<f64>,
     /// Duration, s (default: the record's length).
     #[arg(long, allow_hyphen_values = true)]
     duration: Option<f64>,
     /// Output folder.
     #[arg(long, default_value = "out/report")]
     out: PathBuf,
+    /// Run even if a run is larger than the limit of 1e8 steps.
+    #[arg(long)]
+    confirm_large: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -243,19 +276,12 @@ struct SweepArgs {
         allow_hyphen_values = true
     )]
     amplitude_g: f64,
-    /// Duration of each run, s.
-    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true)]
-    duration: f64,
-    /// DDA time step, s.
-    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
-    dt: f64,
-    /// DDA integrator.
-    #[arg(long, default_value = "generalized-alpha")]
-    integrator: String,
+    #[command(flatten)]
+    stepping: Stepping,
     /// Output folder for sweep.csv and the figures.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 1024 (default: all cores).
     #[arg(long)]
     jobs: Option<usize>,
     /// Run only slice I of N of the grid (e.g. `--shard $SLURM_ARRAY_TASK_ID/16`); join
@@ -272,9 +298,10 @@ struct BenchArgs {
     /// Fewer repeats, shorter windows, a smaller scaling series and sweep (about a minute).
     #[arg(long)]
     quick: bool,
-    /// Repeats of each timed run (the median is reported).
-    #[arg(long, default_value_t = 5)]
-    repeat: usize,
+    /// Repeats of each timed run, 1 to 1000 (the median is reported; default 5, 3 with
+    /// --quick).
+    #[arg(long)]
+    repeat: Option<usize>,
     /// Threads for the sweep (default: all cores).
     #[arg(long)]
     jobs: Option<usize>,
@@ -326,31 +353,55 @@ fn out(line: &str) -> Result<()> {
     }
 }
 
-fn cmd_run(args: RunArgs) -> Result<()> {
-    let integrator = Integrator::parse(&args.integrator)?;
-    let scene = slidebase::model::presets::resolve_scene(&args.scene)?;
-    if scene.structure.is_some() {
-        return cmd_run_frame(args, integrator);
-    }
-    let req = RunRequest {
-        scene: args.scene,
-        alpha: args.alpha.unwrap_or(0.5),
-        friction: args.friction.unwrap_or(0.1),
-        freq_ratio: args.freq_ratio.unwrap_or(1.0),
-        amplitude_g: args.amplitude_g,
-        duration: args.duration,
-        dt: args.dt,
-        integrator,
+/// The run specification of `run`'s flags (every check is the set-up's, shared with the
+/// visualizer and the studies).
+fn run_spec(args: &RunArgs) -> Result<RunSpec> {
+    let integrator = args.stepping.integrator()?;
+    let excitation = match &args.record {
+        Some(name) => ExcitationSpec::record(name.clone()),
+        None if args.amplitude_g.is_some() || args.freq_ratio.is_some() => {
+            ExcitationSpec::Harmonic {
+                amplitude_g: args.amplitude_g,
+                frequency: args.freq_ratio.map(Frequency::Ratio),
+            }
+        }
+        None => ExcitationSpec::Scene,
+    };
+    Ok(RunSpec {
+        scene: args.scene.as_str().into(),
         model: args.model.into(),
+        excitation,
+        alpha: args.alpha,
+        friction: args.friction,
         fixed_base: args.fixed_base,
-        record: args.record,
+        pga_g: None,
         ground: args.ground.map(|g| match g {
             GroundArg::Prescribed => GroundKind::Prescribed,
             GroundArg::LargeMass => GroundKind::LargeMass,
         }),
-        record_every: 10,
-    };
-    let outcome = run(&req)?;
+        duration: args.stepping.duration,
+        dt: args.stepping.dt,
+        integrator,
+        history: HistoryPlan::PeaksOnly,
+        confirm_large: args.stepping.confirm_large,
+    })
+}
+
+fn cmd_run(args: RunArgs) -> Result<()> {
+    let mut setup = run_spec(&args)?.prepare()?;
+    if let Some(dir) = &args.out {
+        // A bad folder is reported now, not after the run.
+        slidebase::post::output::prepare_dir(dir)?;
+        setup.history = if setup.two_block().is_some() {
+            OUTPUT_HISTORY
+        } else {
+            HistoryPlan::EverySteps(1)
+        };
+    }
+    if setup.two_block().is_none() {
+        return cmd_run_frame(&args, &setup);
+    }
+    let outcome = run_setup(&setup)?;
     if let Some(dir) = &args.out {
         let files = write_outputs(&outcome, dir)?;
         if !args.json {
@@ -363,6 +414,7 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     if args.json {
         return out(&serde_json::to_string(s)?);
     }
+    warn(&s.warnings);
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
     out(&format!(
         "{} ({}), α = {}, ρ = {}, {}{}, {:.1} s",
@@ -386,8 +438,14 @@ fn cmd_run(args: RunArgs) -> Result<()> {
         opt(s.ur_max_over_d),
         s.ur_max_m
     ))?;
-    out(&format!("  |a_base|max/a_g   {:.4}", s.abase_over_aground))?;
-    out(&format!("  |a_roof|max/a_g   {:.4}", s.aroof_over_aground))?;
+    out(&format!(
+        "  |a_base|max/a_g   {}",
+        opt(s.abase_over_aground)
+    ))?;
+    out(&format!(
+        "  |a_roof|max/a_g   {}",
+        opt(s.aroof_over_aground)
+    ))?;
     out(&format!("  residual slip     {:.4e} m", s.residual_slip_m))?;
     out(&format!(
         "  {} steps, {} open-close passes, {} Δt cuts, max penetration {:.2e} of size",
@@ -400,32 +458,40 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     out(&format!("  wall time {:.3} s", s.wall_time_s))
 }
 
-fn cmd_sweep(args: SweepArgs) -> Result<()> {
-    let req = SweepRequest {
+/// The thread count of `--jobs`: 1 to [`MAX_JOBS`], or all cores when not given.
+fn jobs(jobs: Option<usize>) -> Result<usize> {
+    use slidebase::limits::MAX_JOBS;
+    match jobs {
+        None => Ok(0),
+        Some(n) if (1..=MAX_JOBS).contains(&n) => Ok(n),
+        Some(n) => bail!("invalid --jobs: {n} threads; give 1 to {MAX_JOBS}"),
+    }
+}
+
+/// The sweep of `sweep`'s flags.
+fn sweep_request(args: &SweepArgs) -> Result<SweepRequest> {
+    Ok(SweepRequest {
         alphas: parse_list("--alpha", &args.alpha)?,
         frictions: parse_list("--friction", &args.friction)?,
         freq_ratios: parse_ratios("--freq-ratios", &args.freq_ratios)?,
         amplitude_g: args.amplitude_g,
-        duration: args.duration,
-        dt: args.dt,
-        integrator: Integrator::parse(&args.integrator)?,
+        duration: args.stepping.duration,
+        dt: args.stepping.dt,
+        integrator: args.stepping.integrator()?,
+        confirm_large: args.stepping.confirm_large,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: args.shard.as_deref().map(parse_shard).transpose()?,
-    };
-    for &a in &req.alphas {
-        if !(a > 0.0 && a < 1.0) {
-            bail!("invalid --alpha: {a} is outside (0, 1)");
-        }
-    }
-    for &f in &req.frictions {
-        if f.is_nan() || f < 0.0 {
-            bail!("invalid --friction: {f} is negative");
-        }
-    }
-    slidebase::error::require_positive("--dt", args.dt)?;
-    slidebase::error::require_positive("--duration", args.duration)?;
+    })
+}
+
+fn cmd_sweep(args: SweepArgs) -> Result<()> {
+    let req = sweep_request(&args)?;
+    let threads = jobs(args.jobs)?;
+    // Every value and the output folder are checked before the first run.
+    req.validate()?;
+    slidebase::post::output::prepare_dir(&args.out)?;
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.jobs.unwrap_or(0))
+        .num_threads(threads)
         .build()?;
     let total = req.jobs().len() as u64;
     let bar = ProgressBar::new(total);
@@ -438,10 +504,10 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
     bar.finish_and_clear();
     match req.shard {
         Some((i, n)) => {
-            std::fs::create_dir_all(&args.out)
-                .with_context(|| format!("creating {}", args.out.display()))?;
+            let mut staged = Staged::new(&args.out)?;
+            slidebase::post::sweep::write_sweep_csv(&staged.path("sweep.csv"), &rows)?;
+            staged.commit()?;
             let csv = args.out.join("sweep.csv");
-            slidebase::post::sweep::write_sweep_csv(&csv, &rows)?;
             out(&format!(
                 "wrote {} (shard {i}/{n}: {} runs in {:.1} s); join the shards with \
                  `slidebase merge --out DIR SHARD/sweep.csv…`",
@@ -475,29 +541,31 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
     Ok(())
 }
 
-/// Writes sweep.csv, the paper's figures and errors.md for a finished sweep.
-fn write_sweep_outputs(rows: &[slidebase::post::sweep::SweepRow], dir: &PathBuf) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let csv = dir.join("sweep.csv");
-    slidebase::post::sweep::write_sweep_csv(&csv, rows)?;
-    out(&format!("wrote {} ({} runs)", csv.display(), rows.len()))?;
-    for f in slidebase::post::sweep::plot_paper_figures(rows, dir)? {
+/// Writes sweep.csv, the paper's figures and errors.md for a finished sweep (all or
+/// nothing).
+fn write_sweep_outputs(rows: &[slidebase::post::sweep::SweepRow], dir: &Path) -> Result<()> {
+    let mut staged = Staged::new(dir)?;
+    slidebase::post::sweep::write_sweep_csv(&staged.path("sweep.csv"), rows)?;
+    slidebase::post::sweep::plot_paper_figures(rows, &mut staged)?;
+    let table = slidebase::post::sweep::error_table(rows, 0.01);
+    staged.write("errors.md", table.to_string())?;
+    for f in staged.commit()? {
         out(&format!("wrote {}", f.display()))?;
     }
-    let table = slidebase::post::sweep::error_table(rows, 0.01);
     out(&format!(
-        "\nDDA against the exact mass-spring model (relative errors, floor 0.01):\n{table}"
-    ))?;
-    let report = dir.join("errors.md");
-    std::fs::write(&report, table.to_string())
-        .with_context(|| format!("writing {}", report.display()))?;
-    Ok(())
+        "\nDDA against the exact mass-spring model (relative errors, floor 0.01, {} runs):\n{table}",
+        rows.len()
+    ))
 }
 
 fn cmd_merge(args: MergeArgs) -> Result<()> {
+    slidebase::post::output::prepare_dir(&args.out)?;
     let mut rows = Vec::new();
     for path in &args.inputs {
         rows.extend(slidebase::post::sweep::read_sweep_csv(path)?);
+    }
+    if rows.is_empty() {
+        bail!("invalid merge: the inputs have no rows (only headers); nothing to join");
     }
     // The same grid point from two shards means the shards overlap (or a file was given
     // twice): say so rather than plot it twice.
@@ -522,12 +590,28 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
     write_sweep_outputs(&rows, &args.out)
 }
 
+/// Repeats of a benchmark: `--repeat` when given (also with `--quick`), else 5, or 3
+/// with `--quick`.
+fn bench_repeats(quick: bool, repeat: Option<usize>) -> Result<usize> {
+    use slidebase::limits::MAX_REPEATS;
+    match repeat {
+        None if quick => Ok(3),
+        None => Ok(5),
+        Some(n) if (1..=MAX_REPEATS).contains(&n) => Ok(n),
+        Some(n) => bail!("invalid --repeat: {n}; give 1 to {MAX_REPEATS}"),
+    }
+}
+
 fn cmd_bench(args: BenchArgs) -> Result<()> {
     use slidebase::headless::bench::{BenchOptions, report_text, run_bench, write_bench};
+    let repeats = bench_repeats(args.quick, args.repeat)?;
+    if let Some(dir) = &args.out {
+        slidebase::post::output::prepare_dir(dir)?;
+    }
     let options = BenchOptions {
         quick: args.quick,
-        repeats: args.repeat.max(1),
-        jobs: args.jobs.unwrap_or(0),
+        repeats,
+        jobs: jobs(args.jobs)?,
         sweep: !args.no_sweep,
         scaling: !args.no_scaling,
     };
@@ -546,45 +630,35 @@ fn cmd_bench(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-fn cmd_run_frame(args: RunArgs, integrator: Integrator) -> Result<()> {
-    use slidebase::headless::frame::{FrameRequest, run_frame, run_mdof};
-    if args.alpha.is_some() || args.freq_ratio.is_some() {
-        bail!(
-            "invalid --alpha/--freq-ratio: they set up the two-block scene, not '{}'",
-            args.scene
-        );
+/// Prints a run's warnings on stderr (the JSON carries them too).
+fn warn(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
     }
-    let req = FrameRequest {
-        scene: args.scene,
-        record: args.record,
-        friction: args.friction,
-        fixed_base: args.fixed_base,
-        dt: args.dt,
-        integrator,
-        duration: args.duration,
-    };
-    let outcome = match args.model {
-        ModelArg::Dda => run_frame(&req)?,
-        ModelArg::MassSpring => run_mdof(&req)?,
-    };
+}
+
+fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<()> {
+    let outcome = slidebase::headless::frame::run_building_setup(setup)?;
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        outcome.history.write_csv(&dir.join("history.csv"))?;
-        std::fs::write(
-            dir.join("summary.json"),
-            serde_json::to_string_pretty(&outcome.summary)?,
-        )
-        .with_context(|| format!("writing {}", dir.display()))?;
+        let files = slidebase::headless::frame::write_outputs(&outcome, dir)?;
+        if !args.json {
+            for f in files {
+                out(&format!("wrote {}", f.display()))?;
+            }
+        }
     }
     let s = &outcome.summary;
     if args.json {
         return out(&serde_json::to_string(s)?);
     }
+    warn(&s.warnings);
     out(&format!(
-        "{} ({}, {}), {}, {}, {:.2} s",
+        "{} ({}{}), {}, {}, {:.2} s",
         s.scene,
         s.model,
-        s.integrator,
+        s.integrator
+            .as_ref()
+            .map_or(String::new(), |i| format!(", {i}")),
         s.record,
         s.friction
             .map_or("fixed base".into(), |f| format!("ρ = {f}")),
@@ -606,20 +680,39 @@ fn cmd_run_frame(args: RunArgs, integrator: Integrator) -> Result<()> {
         "  peak roof drift       {:.4e} m",
         s.peak_roof_drift_m
     ))?;
-    out(&format!(
-        "  base accel spectrum   peak at {:.3} Hz",
-        s.base_accel_peak_freq_hz
-    ))?;
+    if let Some(f) = s.base_accel_peak_freq_hz {
+        out(&format!("  base accel spectrum   peak at {f:.3} Hz"))?;
+    }
     out(&format!(
         "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
         s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
     ))
 }
 
+/// The picture flags of `render` in their ranges (a 10⁵ × 10⁵ picture is 40 GB), checked
+/// before anything is run (and in a build without the window too).
+fn check_picture(args: &RenderArgs) -> Result<()> {
+    use slidebase::limits::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
+    for (flag, v) in [("--width", args.width), ("--height", args.height)] {
+        if let Some(v) = v
+            && !(MIN_IMAGE_SIDE..=MAX_IMAGE_SIDE).contains(&v)
+        {
+            bail!("invalid {flag}: {v} pixels; give {MIN_IMAGE_SIDE} to {MAX_IMAGE_SIDE}");
+        }
+    }
+    if let Some(f) = args.exaggeration
+        && !(f.is_finite() && f > 0.0)
+    {
+        bail!("invalid --exaggeration: {f}; give a finite factor > 0 (1: true scale)");
+    }
+    Ok(())
+}
+
 #[cfg(feature = "gui")]
 fn cmd_render(args: RenderArgs) -> Result<()> {
     use slidebase::export::{PictureOptions, VideoFormat, render_picture, render_video};
     use slidebase::sim::{Excitation, SimConfig};
+    check_picture(&args)?;
     let config = SimConfig {
         scene: args.scene,
         friction: args.friction,
@@ -700,7 +793,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
 }
 
 #[cfg(not(feature = "gui"))]
-fn cmd_render(_args: RenderArgs) -> Result<()> {
+fn cmd_render(args: RenderArgs) -> Result<()> {
+    check_picture(&args)?;
     bail!(
         "this slidebase was built without the `gui` feature, which `render` needs (build with default features)"
     )
@@ -708,6 +802,7 @@ fn cmd_render(_args: RenderArgs) -> Result<()> {
 
 fn cmd_stability(args: StabilityArgs) -> Result<()> {
     use slidebase::headless::stability::{run_stability, write_stability};
+    slidebase::post::output::prepare_dir(&args.out)?;
     let rows = run_stability(!args.quick, &|r| {
         let mark = if r.passed { "ok " } else { "FAIL" };
         eprintln!(
@@ -736,6 +831,7 @@ fn cmd_stability(args: StabilityArgs) -> Result<()> {
 
 fn cmd_accuracy(args: AccuracyArgs) -> Result<()> {
     use slidebase::headless::accuracy::{run_accuracy, write_accuracy};
+    slidebase::post::output::prepare_dir(&args.out)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed_precise} (eta {eta})")
@@ -761,7 +857,11 @@ fn cmd_report(args: ReportArgs) -> Result<()> {
         friction: args.friction,
         dt: args.dt,
         duration: args.duration,
+        confirm_large: args.confirm_large,
     };
+    // The runs' set-up and the output folder are checked before the first run.
+    req.spec().prepare()?;
+    slidebase::post::output::prepare_dir(&args.out)?;
     let bar = ProgressBar::new_spinner();
     bar.set_message("running sliding and fixed base (DDA, two integrators) and the MDOF model…");
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
@@ -775,29 +875,56 @@ fn cmd_report(args: ReportArgs) -> Result<()> {
 }
 
 fn cmd_modes(args: ModesArgs) -> Result<()> {
-    use slidebase::headless::frame::{PAPER_FREQUENCIES_HZ, equivalent_mdof};
+    use slidebase::headless::frame::{
+        MDOF_FIT_TOLERANCE, PAPER_FREQUENCIES_HZ, equivalent_mdof_with, mdof_fit_warning, modes,
+    };
     let scene = slidebase::model::presets::resolve_scene(&args.scene)?;
-    let (building, report) = equivalent_mdof(&scene)?;
+    let report = modes(&scene)?;
+    // The frequencies are reported even when no shear building matches them.
+    let (mdof, report, warning) = match equivalent_mdof_with(&scene, report.clone()) {
+        Ok((building, report)) => {
+            let warning = report
+                .mdof_fit_error
+                .filter(|&e| e > MDOF_FIT_TOLERANCE)
+                .map(mdof_fit_warning);
+            (Some(building), report, warning)
+        }
+        Err(e) => (None, report, Some(format!("no equivalent MDOF model: {e}"))),
+    };
+    // The paper's frequencies are those of its three-storey frame only.
+    let paper = (scene.name == "three-storey").then_some(PAPER_FREQUENCIES_HZ);
     if args.json {
-        let v = serde_json::json!({
+        let mut v = serde_json::json!({
             "scene": report.scene,
             "frequencies_hz": report.frequencies_hz,
             "shapes": report.shapes,
             "levels": report.levels,
-            "paper_frequencies_hz": PAPER_FREQUENCIES_HZ,
-            "mdof": { "raft_mass_kg": building.raft_mass, "storey_masses_kg": building.storey_masses,
-                      "storey_stiffnesses_n_per_m": building.storey_stiffnesses },
+            "warnings": warning.iter().collect::<Vec<_>>(),
         });
+        if let Some(p) = paper {
+            v["paper_frequencies_hz"] = serde_json::json!(p);
+        }
+        if let Some(b) = &mdof {
+            v["mdof"] = serde_json::json!({
+                "raft_mass_kg": b.raft_mass, "storey_masses_kg": b.storey_masses,
+                "storey_stiffnesses_n_per_m": b.storey_stiffnesses,
+                "fit_max_rel_error": report.mdof_fit_error.unwrap_or(0.0) });
+        }
         return out(&serde_json::to_string(&v)?);
+    }
+    if let Some(w) = &warning {
+        eprintln!("warning: {w}");
     }
     out(&format!(
         "{}: fixed-base natural frequencies (DDA stiffness and mass)",
         report.scene
     ))?;
     for (k, f) in report.frequencies_hz.iter().enumerate() {
-        let paper = PAPER_FREQUENCIES_HZ.get(k).map_or(String::new(), |p| {
-            format!("   paper {p:.3} Hz ({:+.2} %)", 100.0 * (f / p - 1.0))
-        });
+        let paper = paper
+            .and_then(|p| p.get(k).copied())
+            .map_or(String::new(), |p| {
+                format!("   paper {p:.3} Hz ({:+.2} %)", 100.0 * (f / p - 1.0))
+            });
         let shape: Vec<String> = report.shapes[k]
             .iter()
             .map(|x| format!("{x:+.3}"))
@@ -811,6 +938,9 @@ fn cmd_modes(args: ModesArgs) -> Result<()> {
         ))?;
     }
     out(&format!("  levels: {}", report.levels.join(", ")))?;
+    let Some(building) = mdof else {
+        return Ok(());
+    };
     out(&format!(
         "equivalent MDOF: raft {:.4e} kg, floors {:?} kg, storey stiffness {:?} N/m",
         building.raft_mass,
@@ -853,13 +983,12 @@ fn cmd_default() -> Result<()> {
     out("           DDA (generalised-α) against the exact mass-spring model\n")?;
     let mut rows = Vec::new();
     for model in [ModelKind::MassSpring, ModelKind::Dda] {
-        let req = RunRequest {
+        let spec = RunSpec {
             model,
             duration: Some(20.0),
-            record_every: 0,
-            ..RunRequest::default()
+            ..RunSpec::default()
         };
-        rows.push(run(&req)?.summary);
+        rows.push(slidebase::headless::run::run(&spec)?.summary);
     }
     out(&format!("  {:<22}{:>14}{:>14}", "", "mass-spring", "DDA"))?;
     let line = |name: &str, f: &dyn Fn(&slidebase::headless::run::RunSummary) -> f64| {
@@ -871,8 +1000,192 @@ fn cmd_default() -> Result<()> {
     out(&line("|u_r|max/D", &|s| {
         s.ur_max_over_d.unwrap_or(f64::NAN)
     }))?;
-    out(&line("|a_base|max/a_g", &|s| s.abase_over_aground))?;
-    out(&line("|a_roof|max/a_g", &|s| s.aroof_over_aground))?;
+    out(&line("|a_base|max/a_g", &|s| {
+        s.abase_over_aground.unwrap_or(f64::NAN)
+    }))?;
+    out(&line("|a_roof|max/a_g", &|s| {
+        s.aroof_over_aground.unwrap_or(f64::NAN)
+    }))?;
     out(&line("wall time (s)", &|s| s.wall_time_s))?;
     out("\nMore: `slidebase run --help`, `slidebase sweep --help`, `slidebase list`.")
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used)]
+
+    use super::*;
+    use slidebase::testing::{Rng, property_cases};
+
+    const NUMBERS: &[&str] = &[
+        "0",
+        "-1",
+        "0.5",
+        "0.1",
+        "1",
+        "3",
+        "1e300",
+        "-1e300",
+        "1e-300",
+        "nan",
+        "inf",
+        "-inf",
+        "1e-12",
+        "1e9",
+        "10",
+        "0.01",
+        "0.005",
+        "0.02",
+        "0.2",
+        "x",
+        "",
+        "18446744073709551615",
+    ];
+
+    /// A random `run` or `sweep` command line from the flags' vocabulary.
+    fn command_line(rng: &mut Rng) -> Vec<String> {
+        let sweep = rng.chance(8);
+        let mut args = vec!["slidebase".to_string()];
+        args.push(if sweep { "sweep" } else { "run" }.into());
+        let flags: &[&str] = if sweep {
+            &[
+                "--alpha",
+                "--friction",
+                "--freq-ratios",
+                "--amplitude-g",
+                "--duration",
+                "--dt",
+                "--integrator",
+                "--jobs",
+                "--shard",
+                "--confirm-large",
+            ]
+        } else {
+            &[
+                "--scene",
+                "--alpha",
+                "--friction",
+                "--freq-ratio",
+                "--amplitude-g",
+                "--duration",
+                "--duration",
+                "--dt",
+                "--integrator",
+                "--model",
+                "--fixed-base",
+                "--record",
+                "--ground",
+                "--json",
+                "--confirm-large",
+                "--bogus",
+            ]
+        };
+        for _ in 0..rng.below(6) {
+            let flag = rng.pick(flags);
+            args.push(flag.into());
+            let value = match flag {
+                "--fixed-base" | "--json" | "--confirm-large" => continue,
+                "--scene" => rng.pick(&[
+                    "two-block",
+                    "three-storey",
+                    "frame:2",
+                    "frame:0",
+                    "frame:101",
+                    "wall:2",
+                    "wall:x",
+                    "missing.toml",
+                    "/dev/zero",
+                ]),
+                "--integrator" => rng.pick(&[
+                    "classic",
+                    "trapezoidal",
+                    "hht:0.1",
+                    "hht:5",
+                    "generalized-alpha:0.5",
+                    "gen-alpha:x",
+                    "euler",
+                ]),
+                "--model" => rng.pick(&["dda", "mass-spring", "fem"]),
+                "--record" => rng.pick(&[
+                    "el-centro",
+                    "el-centro-up",
+                    "kobe-nishi-akashi-000",
+                    "/dev/zero",
+                    "missing.AT2",
+                ]),
+                "--ground" => rng.pick(&["prescribed", "large-mass", "x"]),
+                "--freq-ratios" => rng.pick(&["0.1:10:3", "1:1:1", "0:1:2", "0.5,2", "1:10:1e11"]),
+                "--shard" => rng.pick(&["1/2", "0/2", "3/2", "x", "1/18446744073709551615"]),
+                "--jobs" => rng.pick(&["1", "0", "99999", "x"]),
+                "--alpha" | "--friction" if sweep => {
+                    rng.pick(&["0.1,0.5", "0.5", "-1", "inf", "", "x"])
+                }
+                _ => rng.pick(NUMBERS),
+            };
+            args.push(value.into());
+        }
+        args
+    }
+
+    /// Every command line is refused cleanly or prepares a run; the small ones run, and
+    /// their summaries are finite (no `null` in the JSON). In-process: the same code as
+    /// the binary without spawning it ten thousand times.
+    #[test]
+    fn command_lines_are_refused_cleanly_or_run_finitely() {
+        let cases = property_cases();
+        let (mut prepared, mut ran) = (0, 0);
+        for case in 0..cases {
+            let mut rng = Rng::for_case(0xc11, case);
+            let args = command_line(&mut rng);
+            let result = std::panic::catch_unwind(|| -> Result<Option<bool>> {
+                let Ok(cli) = Cli::try_parse_from(&args) else {
+                    return Ok(None);
+                };
+                match cli.command {
+                    Some(Command::Run(a)) => {
+                        let setup = run_spec(&a)?.prepare()?;
+                        let small =
+                            setup.duration / setup.dt <= 100.0 && setup.scene.blocks.len() <= 3;
+                        if !small {
+                            return Ok(Some(false));
+                        }
+                        let json = if setup.two_block().is_some() {
+                            serde_json::to_string(&run_setup(&setup)?.summary)?
+                        } else {
+                            let o = slidebase::headless::frame::run_building_setup(&setup)?;
+                            serde_json::to_string(&o.summary)?
+                        };
+                        assert!(!json.contains("null"), "{args:?}: {json}");
+                        Ok(Some(true))
+                    }
+                    Some(Command::Sweep(a)) => {
+                        let req = sweep_request(&a)?;
+                        jobs(a.jobs)?;
+                        req.validate()?;
+                        Ok(Some(false))
+                    }
+                    _ => Ok(None),
+                }
+            });
+            match result {
+                Err(_) => panic!("case {case} panicked: {args:?}"),
+                Ok(Err(e)) => assert!(!e.to_string().is_empty(), "{args:?}"),
+                Ok(Ok(Some(r))) => {
+                    prepared += 1;
+                    ran += usize::from(r);
+                }
+                Ok(Ok(None)) => {}
+            }
+        }
+        println!("{cases} command lines: {prepared} prepared, {ran} run");
+    }
+
+    #[test]
+    fn repeat_is_honoured_with_quick_and_bounded() {
+        assert_eq!(bench_repeats(true, None).unwrap(), 3);
+        assert_eq!(bench_repeats(true, Some(7)).unwrap(), 7);
+        assert_eq!(bench_repeats(false, None).unwrap(), 5);
+        assert!(bench_repeats(false, Some(0)).is_err());
+        assert!(bench_repeats(false, Some(usize::MAX)).is_err());
+    }
 }

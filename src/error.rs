@@ -2,8 +2,13 @@
 //!
 //! Every failure a user can cause (a malformed record file, an impossible parameter, a
 //! degenerate polygon, a solver that cannot converge) is reported as an [`Error`] that says
-//! *what* went wrong and *where* (file and line, block name, field name, simulated time).
-//! The library never panics on bad input; the binary adds context with `anyhow`.
+//! *what* went wrong, *where* (file and line, block name, field or flag, simulated time)
+//! and, where there is one, what would be accepted. The kinds a user meets: a scene
+//! ([`Error::Scene`], [`Error::Parse`] of its TOML), a record ([`Error::Record`]), a
+//! parameter or flag ([`Error::InvalidParameter`], [`Error::Unknown`]), an output or I/O
+//! problem ([`Error::Output`], [`Error::Io`], which always name the file) and the solver
+//! ([`Error::Solver`]). The library never panics on bad input; the binary adds context
+//! with `anyhow`.
 
 use std::path::PathBuf;
 
@@ -23,7 +28,29 @@ pub enum Error {
         source: std::io::Error,
     },
 
-    /// A file was read but its contents are malformed.
+    /// An output path that cannot be used (a file where a folder is wanted, a folder that
+    /// cannot be created or written).
+    #[error("output {path}: {message}")]
+    Output {
+        /// The path concerned.
+        path: PathBuf,
+        /// What is wrong and what would work.
+        message: String,
+    },
+
+    /// A ground-motion record (file or built-in) that is malformed or outside the range a
+    /// run can use.
+    #[error("record {file}:{line}: {message}")]
+    Record {
+        /// The file (or `<built-in NAME>`).
+        file: String,
+        /// 1-based line number; 0 when the problem concerns the whole record.
+        line: usize,
+        /// What is wrong, in words a user can act on.
+        message: String,
+    },
+
+    /// A file (scene TOML, sweep table) was read but its contents are malformed.
     #[error("{file}:{line}: {message}")]
     Parse {
         /// The file (or a label such as `<built-in el-centro>`).
@@ -90,12 +117,39 @@ impl Error {
         }
     }
 
+    /// Shorthand for [`Error::Record`].
+    pub fn record(file: impl Into<String>, line: usize, message: impl Into<String>) -> Self {
+        Error::Record {
+            file: file.into(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Output`].
+    pub fn output(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Error::Output {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+
     /// Shorthand for [`Error::Io`].
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),
             source,
         }
+    }
+}
+
+/// A number as a message shows it: plain for ordinary magnitudes, in exponent form for
+/// very large or very small ones (so that 1e-300 is not three hundred zeros).
+pub fn show(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }
 
@@ -106,7 +160,7 @@ pub fn require_positive(field: &str, value: f64) -> Result<f64> {
     } else {
         Err(Error::invalid(
             field,
-            format!("must be a finite number > 0, got {value}"),
+            format!("must be a finite number > 0, got {}", show(value)),
         ))
     }
 }
@@ -118,7 +172,30 @@ pub fn require_non_negative(field: &str, value: f64) -> Result<f64> {
     } else {
         Err(Error::invalid(
             field,
-            format!("must be a finite number >= 0, got {value}"),
+            format!("must be a finite number >= 0, got {}", show(value)),
+        ))
+    }
+}
+
+/// Checks that a parameter is finite and within `[lo, hi]`; the message gives the range
+/// and its unit.
+pub fn require_range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<f64> {
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        Err(Error::invalid(
+            field,
+            format!(
+                "must be a number in [{}, {}]{unit}, got {}",
+                show(lo),
+                show(hi),
+                show(value)
+            ),
         ))
     }
 }

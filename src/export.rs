@@ -12,6 +12,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+use crate::limits::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
 use crate::render::offscreen::{Gpu, OffscreenUi, write_png};
 use crate::sim::{SimConfig, run_to_messages};
 use crate::ui::{AppState, Exaggeration, PlotData, scene::draw_scene};
@@ -96,10 +97,10 @@ fn draw(
 /// Checks the sizes of a picture or video.
 fn check_options(options: &PictureOptions) -> Result<()> {
     for (name, v) in [("--width", options.width), ("--height", options.height)] {
-        if !(64..=8192).contains(&v) {
+        if !(MIN_IMAGE_SIDE..=MAX_IMAGE_SIDE).contains(&v) {
             return Err(Error::invalid(
                 name,
-                format!("{v} pixels is outside 64…8192"),
+                format!("{v} pixels is outside {MIN_IMAGE_SIDE}…{MAX_IMAGE_SIDE}"),
             ));
         }
     }
@@ -124,11 +125,13 @@ pub fn render_picture(
 ) -> Result<ExportInfo> {
     crate::error::require_non_negative("--time", time)?;
     check_options(options)?;
-    let gpu = Gpu::new()?;
+    // The run is checked (and computed) before the graphics adapter is looked for, so that
+    // a bad flag is reported as such on any machine.
     let t0 = std::time::Instant::now();
     let mut state = state_until(config, time, options)?;
     state.play_time = time.min(state.timeline.available());
     let simulate_s = t0.elapsed().as_secs_f64();
+    let gpu = Gpu::new()?;
     let t1 = std::time::Instant::now();
     let mut offscreen = OffscreenUi::new(&gpu);
     let pixels = draw(&mut offscreen, &mut state, options.width, options.height)?;
@@ -246,10 +249,10 @@ pub fn render_video(
             path.display()
         ));
     }
-    let gpu = Gpu::new()?;
     let t0 = std::time::Instant::now();
     let mut state = state_until(config, to, options)?;
     let simulate_s = t0.elapsed().as_secs_f64();
+    let gpu = Gpu::new()?;
     let t1 = std::time::Instant::now();
     // Even sizes: H.264 in yuv420p needs them.
     let (w, h) = (options.width & !1, options.height & !1);

@@ -12,6 +12,8 @@
 //!   iteration, bolts and connection elements, integrators, energy bookkeeping.
 //! - `analytic`: the paper's mass-spring models, solved exactly (event-driven).
 //! - `post`: time histories, metrics, spectra and plots.
+//! - [`setup`]: the one way a run is specified, validated and set up (command line,
+//!   visualizer and studies alike).
 //!
 //! The engine never depends on rendering; the visualizer lives behind the `gui` feature.
 
@@ -24,12 +26,15 @@ pub mod error;
 pub mod export;
 pub mod ground_motion;
 pub mod headless;
+pub mod limits;
 pub mod linalg;
 pub mod model;
 pub mod post;
 #[cfg(feature = "gui")]
 pub mod render;
+pub mod setup;
 pub mod sim;
+pub mod testing;
 #[cfg(feature = "gui")]
 pub mod ui;
 

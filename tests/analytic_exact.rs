@@ -107,6 +107,7 @@ fn tighter_tolerances_change_nothing() {
         quadrature_points: 14,
         samples_per_step: 8,
         root_tolerance: 1e-14,
+        ..ExactOptions::default()
     };
     for &(alpha, rho, ratio) in &[(0.5, 0.1, 1.0), (0.1, 0.25, 0.3), (0.9, 0.05, 4.6)] {
         let b = ShearBuilding::two_mass(alpha, 1.0, rho).unwrap();

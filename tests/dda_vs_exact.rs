@@ -5,10 +5,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use slidebase::dda::Integrator;
-use slidebase::headless::run::{RunRequest, run};
+use slidebase::headless::run::run;
 use slidebase::headless::sweep::{SweepRequest, parse_ratios, run_sweep};
-use slidebase::headless::two_block::ModelKind;
 use slidebase::post::sweep::error_table;
+use slidebase::setup::{ExcitationSpec, ModelKind, RunSpec};
 
 fn sweep(
     alphas: Vec<f64>,
@@ -21,9 +21,10 @@ fn sweep(
         frictions,
         freq_ratios: ratios,
         amplitude_g: 0.3,
-        duration,
-        dt: 1e-3,
-        integrator: Integrator::default(),
+        duration: Some(duration),
+        dt: Some(1e-3),
+        integrator: Some(Integrator::default()),
+        confirm_large: false,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: None,
     };
@@ -101,14 +102,14 @@ fn full_paper_grid_meets_the_acceptance_bounds() {
 #[test]
 fn fixed_base_dda_is_the_sdof_oscillator() {
     for &ratio in &[0.5, 2.0] {
-        let req = RunRequest {
+        let req = RunSpec {
             fixed_base: true,
-            freq_ratio: ratio,
+            excitation: ExcitationSpec::ratio(ratio),
             duration: Some(10.0),
-            ..RunRequest::default()
+            ..RunSpec::default()
         };
         let dda = run(&req).unwrap();
-        let exact = run(&RunRequest {
+        let exact = run(&RunSpec {
             model: ModelKind::MassSpring,
             ..req
         })
@@ -133,11 +134,11 @@ fn fixed_base_dda_is_the_sdof_oscillator() {
 /// displacement, ΩT − sin ΩT in units of D.
 #[test]
 fn frictionless_dda_raft_stays_put() {
-    let req = RunRequest {
-        friction: 0.0,
-        freq_ratio: 1.0,
+    let req = RunSpec {
+        friction: Some(0.0),
+        excitation: ExcitationSpec::ratio(1.0),
         duration: Some(10.0),
-        ..RunRequest::default()
+        ..RunSpec::default()
     };
     let s = run(&req).unwrap().summary;
     let omega_t = 2.0 * std::f64::consts::PI * 10.0;

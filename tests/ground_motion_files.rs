@@ -19,14 +19,14 @@ fn data(name: &str) -> std::path::PathBuf {
         .join(name)
 }
 
-/// The error must be a parse error at `line` whose message contains `fragment`.
+/// The error must be a record error at `line` whose message contains `fragment`.
 fn assert_parse_error(
     result: slidebase::Result<slidebase::ground_motion::Record>,
     line: usize,
     fragment: &str,
 ) {
     match result {
-        Err(Error::Parse {
+        Err(Error::Record {
             line: l, message, ..
         }) => {
             assert_eq!(l, line, "wrong line for '{message}'");
@@ -35,7 +35,7 @@ fn assert_parse_error(
                 "message '{message}' lacks '{fragment}'"
             );
         }
-        other => panic!("expected a parse error at line {line}, got {other:?}"),
+        other => panic!("expected a record error at line {line}, got {other:?}"),
     }
 }
 
@@ -100,7 +100,7 @@ fn bad_at2_files() {
     assert_parse_error(
         parse_at2("a\nb\nc\nNPTS= 3, DT= 0.0 SEC\n1 2 3\n", "z.AT2", "z"),
         4,
-        "DT must be > 0",
+        "time step 0 s is outside [1e-5, 1] s",
     );
     assert_parse_error(
         parse_at2("a\nb\nc\nNPTS= 4, DT= .01 SEC\n1 2\n3\n", "f.AT2", "f"),

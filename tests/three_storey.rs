@@ -5,10 +5,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use slidebase::headless::frame::{
-    FrameRequest, PAPER_FREQUENCIES_HZ, equivalent_mdof, free_vibration_frequencies, modes,
-    run_frame, run_mdof,
+    PAPER_FREQUENCIES_HZ, equivalent_mdof, free_vibration_frequencies, modes, run_frame, run_mdof,
 };
 use slidebase::model::presets::resolve_scene;
+use slidebase::setup::{ExcitationSpec, RunSpec};
 
 /// The fixed-base frame has the paper's natural frequencies 0.638, 1.788 and 2.583 Hz
 /// (each within 2 %), from the DDA tangent stiffness and mass.
@@ -87,7 +87,7 @@ fn equivalent_mdof_has_the_frame_mass_and_frequencies() {
 /// docs/three-storey.md); it is checked within 30 %.
 #[test]
 fn sliding_frame_matches_the_mdof_model() {
-    let req = FrameRequest::default();
+    let req = RunSpec::scene("three-storey");
     let dda = run_frame(&req).unwrap().summary;
     let mdof = run_mdof(&req).unwrap().summary;
     let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
@@ -127,9 +127,9 @@ fn sliding_frame_matches_the_mdof_model() {
 /// frame's third mode is not exactly a shear-building mode) and the roof drifts within 2 %.
 #[test]
 fn fixed_base_frame_matches_the_mdof_model() {
-    let req = FrameRequest {
+    let req = RunSpec {
         fixed_base: true,
-        ..FrameRequest::default()
+        ..RunSpec::scene("three-storey")
     };
     let dda = run_frame(&req).unwrap().summary;
     let mdof = run_mdof(&req).unwrap().summary;
@@ -153,16 +153,25 @@ fn fixed_base_frame_matches_the_mdof_model() {
     );
 }
 
-/// Robustness: the frame on every shipped record (up to the 1.2 g Pacoima Dam) runs to the
-/// end, without NaN, with an energy residual below 1 %. Slow: `cargo test --release -- --ignored`.
+/// Robustness: the frame on every shipped horizontal record (up to the 1.2 g Pacoima Dam)
+/// runs to the end, without NaN, with an energy residual below 1 %. Slow: `cargo test --release -- --ignored`.
 #[test]
 #[ignore]
 fn every_shipped_record_runs_to_the_end() {
     for name in slidebase::ground_motion::builtin_names() {
-        let req = FrameRequest {
-            record: Some(name.to_string()),
-            ..FrameRequest::default()
+        let req = RunSpec {
+            excitation: ExcitationSpec::record(name),
+            ..RunSpec::scene("three-storey")
         };
+        // A vertical component is not a horizontal ground motion: refused, not run.
+        if slidebase::ground_motion::builtin_record(name)
+            .unwrap()
+            .is_vertical()
+        {
+            let e = run_frame(&req).unwrap_err().to_string();
+            assert!(e.contains("vertical"), "{name}: {e}");
+            continue;
+        }
         let s = run_frame(&req)
             .unwrap_or_else(|e| panic!("{name}: {e}"))
             .summary;

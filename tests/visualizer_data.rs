@@ -56,15 +56,13 @@ fn spectrum_of_a_1_hz_harmonic_peaks_at_1_hz() {
 #[test]
 fn el_centro_spectrum_peak_agrees_with_run_json() {
     let duration = 31.0;
-    let headless =
-        slidebase::headless::frame::run_frame(&slidebase::headless::frame::FrameRequest {
-            scene: "three-storey".into(),
-            friction: Some(0.01),
-            duration: Some(duration),
-            ..Default::default()
-        })
-        .unwrap();
-    let expected = headless.summary.base_accel_peak_freq_hz;
+    let headless = slidebase::headless::frame::run_frame(&slidebase::setup::RunSpec {
+        friction: Some(0.01),
+        duration: Some(duration),
+        ..slidebase::setup::RunSpec::scene("three-storey")
+    })
+    .unwrap();
+    let expected = headless.summary.base_accel_peak_freq_hz.unwrap();
     let config = SimConfig {
         scene: "three-storey".into(),
         friction: Some(0.01),
@@ -223,4 +221,44 @@ fn connected_blocks_stay_joined_at_x1000() {
             "roof offset {real} against the probe's drift {drift}"
         );
     }
+}
+
+/// Issue 12, "record information and scaling to a chosen PGA", and the friction
+/// comparison: both go through the one run set-up. El Centro scaled to 0.5 g peaks at
+/// 0.5 g over the run (factor 0.5 g / 0.348 g as recorded); a PGA or a comparison
+/// friction out of range is refused by name.
+#[test]
+fn pga_scaling_and_friction_variants_go_through_the_run_setup() {
+    use slidebase::ground_motion::STANDARD_GRAVITY as G;
+    use slidebase::setup::RunSpec;
+    let duration = 5.0;
+    let spec = |pga_g| RunSpec {
+        pga_g,
+        duration: Some(duration),
+        ..RunSpec::scene("three-storey")
+    };
+    let recorded = spec(None).prepare().unwrap();
+    let scaled = spec(Some(0.5)).prepare().unwrap();
+    let peak = |s: &slidebase::setup::RunSetup| s.motion.peak_accel(duration) / G;
+    assert!(
+        (peak(&scaled) - 0.5).abs() < 1e-9,
+        "peak {} g",
+        peak(&scaled)
+    );
+    assert!((scaled.motion_scale * peak(&recorded) - 0.5).abs() < 1e-9);
+    assert_eq!(recorded.motion_scale, 1.0);
+    let e = spec(Some(0.0)).prepare().unwrap_err().to_string();
+    assert!(e.contains("--pga"), "{e}");
+    let variant = recorded.friction_variant_scene(0.2).unwrap();
+    let joint = variant
+        .contacts
+        .iter()
+        .find(|c| c.name == recorded.joint)
+        .unwrap();
+    assert_eq!(joint.friction, 0.2);
+    let e = recorded
+        .friction_variant_scene(f64::NAN)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("comparison friction"), "{e}");
 }

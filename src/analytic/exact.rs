@@ -44,6 +44,9 @@ pub struct ExactOptions {
     pub samples_per_step: usize,
     /// Absolute tolerance of event and extremum times, s.
     pub root_tolerance: f64,
+    /// Phase changes kept in [`ExactResult::events`] (the first ones; later ones still
+    /// count in the peaks and energies), so that memory does not grow with the duration.
+    pub max_events: usize,
 }
 
 impl Default for ExactOptions {
@@ -53,6 +56,7 @@ impl Default for ExactOptions {
             quadrature_points: 10,
             samples_per_step: 4,
             root_tolerance: 1e-13,
+            max_events: 100_000,
         }
     }
 }
@@ -669,10 +673,12 @@ pub fn simulate(
                     end.v_s = 0.0;
                 }
                 offer_peaks(&solver, &mut peaks, &end);
-                result.events.push(PhaseEvent {
-                    time: end.t,
-                    phase: next,
-                });
+                if result.events.len() < opts.max_events {
+                    result.events.push(PhaseEvent {
+                        time: end.t,
+                        phase: next,
+                    });
+                }
             }
         }
         state = end;

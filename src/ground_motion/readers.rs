@@ -4,7 +4,45 @@
 use std::path::Path;
 
 use super::{Record, STANDARD_GRAVITY};
+use crate::limits::{MAX_ACCEL_G, MAX_RECORD_FILE_BYTES, MAX_RECORD_SAMPLES, RECORD_DT_RANGE};
 use crate::{Error, Result};
+
+/// The text without a leading UTF-8 byte-order mark (spreadsheets write one).
+fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
+
+/// An acceleration in g from a record file, checked against [`MAX_ACCEL_G`].
+fn accel_g(value: f64, file: &str, line: usize) -> Result<f64> {
+    if value.abs() > MAX_ACCEL_G {
+        return Err(Error::record(
+            file,
+            line,
+            format!(
+                "acceleration {} g is beyond ±{MAX_ACCEL_G} g (accelerations are in g; \
+                 the largest ever recorded is about 4 g)",
+                crate::error::show(value)
+            ),
+        ));
+    }
+    Ok(value * STANDARD_GRAVITY)
+}
+
+/// Checks a record's sample spacing against [`RECORD_DT_RANGE`].
+fn check_dt(dt: f64, file: &str, line: usize) -> Result<()> {
+    let (lo, hi) = RECORD_DT_RANGE;
+    if !(dt.is_finite() && (lo..=hi).contains(&dt)) {
+        return Err(Error::record(
+            file,
+            line,
+            format!(
+                "time step {} s is outside [{lo:e}, {hi}] s",
+                crate::error::show(dt)
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// Parses a number as Fortran writes it (`-.123E-02`, `1.5D-03`), rejecting NaN and inf.
 fn parse_number(token: &str) -> Option<f64> {
@@ -40,12 +78,12 @@ fn header_value(upper: &str, key: &str) -> Option<f64> {
 /// step (`NPTS=  5372, DT=   .0100 SEC`, or the older `  4000   .01000   NPTS, DT`), then the
 /// accelerations in g, any number per line. The first value is at t = 0.
 pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
-    let lines: Vec<&str> = text.lines().collect();
+    let lines: Vec<&str> = without_bom(text).lines().collect();
     if lines.iter().all(|l| l.trim().is_empty()) {
-        return Err(Error::parse(file_label, 0, "the file is empty"));
+        return Err(Error::record(file_label, 0, "the file is empty"));
     }
     if lines.len() < 4 {
-        return Err(Error::parse(
+        return Err(Error::record(
             file_label,
             lines.len(),
             "an AT2 file needs four header lines (the fourth gives NPTS and DT)",
@@ -56,14 +94,14 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
     let (npts, dt) =
         if upper.contains("NPTS") && (upper.contains("NPTS=") || upper.contains("NPTS =")) {
             let npts = header_value(&upper, "NPTS").ok_or_else(|| {
-                Error::parse(
+                Error::record(
                     file_label,
                     4,
                     format!("cannot read NPTS from '{}'", header.trim()),
                 )
             })?;
             let dt = header_value(&upper, "DT").ok_or_else(|| {
-                Error::parse(
+                Error::record(
                     file_label,
                     4,
                     format!("cannot read DT from '{}'", header.trim()),
@@ -81,7 +119,7 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
             ) {
                 (Some(n), Some(d)) => (n, d),
                 _ => {
-                    return Err(Error::parse(
+                    return Err(Error::record(
                         file_label,
                         4,
                         format!("expected 'count step NPTS, DT', got '{}'", header.trim()),
@@ -89,7 +127,7 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
                 }
             }
         } else {
-            return Err(Error::parse(
+            return Err(Error::record(
                 file_label,
                 4,
                 format!(
@@ -98,51 +136,51 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
                 ),
             ));
         };
-    if !(npts >= 1.0 && npts.fract() == 0.0) {
-        return Err(Error::parse(
+    if !(npts >= 2.0 && npts.fract() == 0.0) {
+        return Err(Error::record(
             file_label,
             4,
-            format!("NPTS must be a positive whole number, got {npts}"),
+            format!("NPTS must be a whole number >= 2, got {npts}"),
         ));
     }
-    if dt <= 0.0 {
-        return Err(Error::parse(
+    // Checked before anything is allocated.
+    if npts > MAX_RECORD_SAMPLES as f64 {
+        return Err(Error::record(
             file_label,
             4,
-            format!("DT must be > 0, got {dt}"),
+            format!(
+                "NPTS = {} is beyond the limit of {MAX_RECORD_SAMPLES} samples",
+                crate::error::show(npts)
+            ),
         ));
     }
+    check_dt(dt, file_label, 4)?;
     let npts = npts as usize;
-    let mut values = Vec::with_capacity(npts);
+    // A header can promise more values than the file holds: reserve only what the text
+    // could contain (each value takes at least two characters).
+    let mut values = Vec::with_capacity(npts.min(text.len() / 2 + 1));
     for (k, line) in lines.iter().enumerate().skip(4) {
         for token in line
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter(|t| !t.is_empty())
         {
             let v = parse_number(token)
-                .ok_or_else(|| Error::parse(file_label, k + 1, number_error(token)))?;
+                .ok_or_else(|| Error::record(file_label, k + 1, number_error(token)))?;
             if values.len() == npts {
-                return Err(Error::parse(
+                return Err(Error::record(
                     file_label,
                     k + 1,
                     format!("more values than NPTS = {npts} (the header and the data disagree)"),
                 ));
             }
-            values.push(v * STANDARD_GRAVITY);
+            values.push(accel_g(v, file_label, k + 1)?);
         }
     }
     if values.len() != npts {
-        return Err(Error::parse(
+        return Err(Error::record(
             file_label,
             lines.len(),
             format!("NPTS = {npts} but the file has {} values", values.len()),
-        ));
-    }
-    if values.len() < 2 {
-        return Err(Error::parse(
-            file_label,
-            lines.len(),
-            "a record needs at least two samples",
         ));
     }
     let provenance = lines[..3]
@@ -153,6 +191,19 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
     Ok(Record::new(name, dt, values)?.with_provenance(provenance))
 }
 
+/// A header row: every field a word (a column name), none a number — so that a number
+/// mistyped in the first row (`1.0e,0.3`) is an error, not a silently dropped sample.
+fn is_header(fields: &[&str]) -> bool {
+    !fields.is_empty()
+        && fields.iter().all(|f| {
+            let word = f.trim_matches(|c| c == '"' || c == '\'');
+            word.chars()
+                .next()
+                .is_some_and(|c| c.is_alphabetic() || c == '_')
+                && word.parse::<f64>().is_err()
+        })
+}
+
 /// Parses two-column text: time (s) and acceleration (g), separated by commas, semicolons,
 /// tabs or spaces; `#` comment lines (kept as provenance), blank lines and one header line
 /// before the data are allowed. Times must increase uniformly from 0 (or from one step,
@@ -161,7 +212,7 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
     let mut comments = Vec::new();
     let mut rows: Vec<(usize, f64, f64)> = Vec::new();
     let mut header_seen = false;
-    for (k, raw) in text.lines().enumerate() {
+    for (k, raw) in without_bom(text).lines().enumerate() {
         let line = raw.trim();
         if line.is_empty() {
             continue;
@@ -174,15 +225,12 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
             .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
             .filter(|t| !t.is_empty())
             .collect();
-        let first_is_text = fields
-            .first()
-            .is_some_and(|f| parse_number(f).is_none() && number_error(f).contains("not a number"));
-        if rows.is_empty() && !header_seen && first_is_text {
+        if rows.is_empty() && !header_seen && is_header(&fields) {
             header_seen = true;
             continue;
         }
         if fields.len() != 2 {
-            return Err(Error::parse(
+            return Err(Error::record(
                 file_label,
                 k + 1,
                 format!(
@@ -191,14 +239,22 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
                 ),
             ));
         }
+        if rows.len() == MAX_RECORD_SAMPLES {
+            return Err(Error::record(
+                file_label,
+                k + 1,
+                format!("more than {MAX_RECORD_SAMPLES} samples, the limit of a record"),
+            ));
+        }
         let t = parse_number(fields[0])
-            .ok_or_else(|| Error::parse(file_label, k + 1, number_error(fields[0])))?;
+            .ok_or_else(|| Error::record(file_label, k + 1, number_error(fields[0])))?;
         let a = parse_number(fields[1])
-            .ok_or_else(|| Error::parse(file_label, k + 1, number_error(fields[1])))?;
+            .ok_or_else(|| Error::record(file_label, k + 1, number_error(fields[1])))?;
+        let a = accel_g(a, file_label, k + 1)?;
         if let Some(&(_, tp, _)) = rows.last()
             && t <= tp
         {
-            return Err(Error::parse(
+            return Err(Error::record(
                 file_label,
                 k + 1,
                 format!("time {t} does not increase (previous row: {tp})"),
@@ -207,10 +263,10 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
         rows.push((k + 1, t, a));
     }
     if rows.is_empty() {
-        return Err(Error::parse(file_label, 0, "the file has no data rows"));
+        return Err(Error::record(file_label, 0, "the file has no data rows"));
     }
     if rows.len() < 2 {
-        return Err(Error::parse(
+        return Err(Error::record(
             file_label,
             rows[0].0,
             "a record needs at least two samples",
@@ -223,7 +279,7 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
     for w in rows.windows(2) {
         let step = w[1].1 - w[0].1;
         if (step - first_step).abs() > 0.01 * first_step {
-            return Err(Error::parse(
+            return Err(Error::record(
                 file_label,
                 w[1].0,
                 format!(
@@ -234,13 +290,14 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
     }
     // The mean step is the most accurate value when times carry rounding.
     let dt = (rows[rows.len() - 1].1 - t0) / (rows.len() - 1) as f64;
-    let mut accel: Vec<f64> = rows.iter().map(|r| r.2 * STANDARD_GRAVITY).collect();
+    check_dt(dt, file_label, rows[1].0)?;
+    let mut accel: Vec<f64> = rows.iter().map(|r| r.2).collect();
     if t0.abs() > 0.01 * dt {
         if (t0 - dt).abs() <= 0.01 * dt {
             // The first sample is at one step: the record starts from rest at t = 0.
             accel.insert(0, 0.0);
         } else {
-            return Err(Error::parse(
+            return Err(Error::record(
                 file_label,
                 rows[0].0,
                 format!(
@@ -255,7 +312,7 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
 /// Reads a record file: AT2 when the extension is `.at2` (any case) or the fourth line
 /// mentions NPTS, two-column text otherwise. The record is named after the file stem.
 pub fn read_record_file(path: &Path) -> Result<Record> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::limits::read_text(path, MAX_RECORD_FILE_BYTES, "record")?;
     let label = path.display().to_string();
     let name = path
         .file_stem()

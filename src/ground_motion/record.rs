@@ -1,5 +1,7 @@
 //! A recorded accelerogram: uniform samples, linear interpolation, exact integrals.
 
+use super::STANDARD_GRAVITY;
+use crate::limits::{MAX_ACCEL_G, MAX_RECORD_SAMPLES, RECORD_DT_RANGE};
 use crate::{Error, Result};
 
 /// A uniformly sampled ground-acceleration record starting from rest at t = 0.
@@ -26,21 +28,41 @@ pub struct Record {
 impl Record {
     /// Builds a record from samples in m/s² at spacing `dt`, the first at t = 0.
     ///
-    /// Fails on an empty record, a non-positive or non-finite `dt`, or a non-finite sample.
+    /// Fails on fewer than two or more than [`MAX_RECORD_SAMPLES`] samples, a `dt` outside
+    /// [`RECORD_DT_RANGE`], or a sample that is not finite or beyond ±[`MAX_ACCEL_G`] g.
     pub fn new(name: impl Into<String>, dt: f64, accel: Vec<f64>) -> Result<Self> {
         let name = name.into();
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(Error::parse(
+        let (lo, hi) = RECORD_DT_RANGE;
+        if !(dt.is_finite() && (lo..=hi).contains(&dt)) {
+            return Err(Error::record(
                 &name,
                 0,
-                format!("time step must be > 0, got {dt}"),
+                format!("time step must be in [{lo:e}, {hi}] s, got {dt}"),
             ));
         }
-        if accel.is_empty() {
-            return Err(Error::parse(&name, 0, "record has no samples"));
+        if accel.len() < 2 || accel.len() > MAX_RECORD_SAMPLES {
+            return Err(Error::record(
+                &name,
+                0,
+                format!(
+                    "a record needs 2 to {MAX_RECORD_SAMPLES} samples, got {}",
+                    accel.len()
+                ),
+            ));
         }
-        if let Some(k) = accel.iter().position(|a| !a.is_finite()) {
-            return Err(Error::parse(&name, 0, format!("sample {k} is not finite")));
+        let limit = MAX_ACCEL_G * STANDARD_GRAVITY;
+        if let Some(k) = accel
+            .iter()
+            .position(|a| !(a.is_finite() && a.abs() <= limit))
+        {
+            return Err(Error::record(
+                &name,
+                0,
+                format!(
+                    "sample {k} ({} m/s²) is not finite or beyond ±{MAX_ACCEL_G} g",
+                    accel[k]
+                ),
+            ));
         }
         let n = accel.len();
         let mut vel = vec![0.0; n];
@@ -71,6 +93,27 @@ impl Record {
         crate::error::require_positive("record scale factor", factor)?;
         let accel = self.accel.iter().map(|a| a * factor).collect();
         Ok(Self::new(self.name.clone(), self.dt, accel)?.with_provenance(self.provenance.clone()))
+    }
+
+    /// Whether the record says it is a vertical component: a `component:` note naming it
+    /// up, down or vertical (the shipped CSV files), or a PEER AT2 title line ending in
+    /// `UP`, `DWN` or `V`. slidebase's ground motion is horizontal, so such a record is
+    /// refused as input.
+    pub fn is_vertical(&self) -> bool {
+        self.provenance.split(['\n', '/']).any(|line| {
+            let lower = line.trim().to_lowercase();
+            if let Some(component) = lower.strip_prefix("component:") {
+                let words: Vec<&str> = component
+                    .split(|c: char| !c.is_alphanumeric())
+                    .filter(|w| !w.is_empty())
+                    .collect();
+                return words
+                    .iter()
+                    .any(|w| matches!(*w, "up" | "dwn" | "down" | "vertical" | "vert"));
+            }
+            let last = lower.rsplit(',').next().unwrap_or("").trim();
+            lower.contains(',') && matches!(last, "up" | "dwn" | "down" | "v" | "vert" | "vertical")
+        })
     }
 
     /// Acceleration samples, m/s².

@@ -7,13 +7,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::frame::{FrameRequest, run_frame, run_mdof};
-use super::run::{RunRequest, two_block_setup};
-use super::two_block::{self, TwoBlockRun};
+use super::frame::{run_frame, run_mdof};
+use super::simulate::{self, ModelRun};
+use crate::Result;
 use crate::dda::{Integrator, SolverParams};
 use crate::model::scene::GroundKind;
+use crate::post::output::Staged;
 use crate::post::plot::{Figure, Series};
-use crate::{Error, Result};
+use crate::setup::{ExcitationSpec, HistoryPlan, RunSpec};
 
 /// One run of the study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -125,7 +126,7 @@ fn interp(t: &[f64], y: &[f64], at: f64) -> f64 {
 }
 
 /// RMS over the reference's times of (run − reference) for one history column.
-fn rms(run: &TwoBlockRun, reference: &TwoBlockRun, column: &str) -> f64 {
+fn rms(run: &ModelRun, reference: &ModelRun, column: &str) -> f64 {
     let (Some(t), Some(y)) = (run.history.column("time_s"), run.history.column(column)) else {
         return f64::NAN;
     };
@@ -160,14 +161,15 @@ fn two_block_row(
     penalty: Option<f64>,
     ground: Option<(GroundKind, f64)>,
     fixed_base: bool,
-    reference: &TwoBlockRun,
-    converged: Option<&TwoBlockRun>,
+    reference: &ModelRun,
+    converged: Option<&ModelRun>,
 ) -> Result<AccuracyRow> {
-    let req = RunRequest {
-        integrator,
-        ..case_request(case, duration, dt, fixed_base)
+    let spec = RunSpec {
+        integrator: Some(integrator),
+        ..case_spec(case, duration, dt, fixed_base)
     };
-    let mut setup = two_block_setup(&req)?;
+    let mut setup = spec.prepare()?;
+    setup.history = HistoryPlan::EverySteps(record_every(dt));
     if let Some(p) = penalty {
         for c in setup.scene.contacts.iter_mut() {
             c.normal_penalty = Some(p);
@@ -191,12 +193,15 @@ fn two_block_row(
         ..SolverParams::default()
     };
     let start = Instant::now();
-    let run = two_block::run_dda(&setup.scene, &setup.motion, params, record_every(dt))?;
+    let run = simulate::run_dda(&setup, &setup.scene, params)?;
     let wall = start.elapsed().as_secs_f64();
     let a = setup.motion.peak_accel(duration);
-    let big_omega = 2.0 * std::f64::consts::PI * case.ratio * setup.roles.structure_frequency_hz;
+    let structure_hz = setup
+        .two_block()
+        .map_or(f64::NAN, |(roles, _, _)| roles.structure_frequency_hz);
+    let big_omega = 2.0 * std::f64::consts::PI * case.ratio * structure_hz;
     let d = a / (big_omega * big_omega);
-    let metrics = |r: &TwoBlockRun| {
+    let metrics = |r: &ModelRun| {
         [
             r.peaks.slip_m / d,
             r.peaks.drift_m / d,
@@ -233,16 +238,16 @@ fn two_block_row(
     })
 }
 
-/// The run request of a case (default integrator).
-fn case_request(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> RunRequest {
-    RunRequest {
-        alpha: case.alpha,
-        friction: case.friction,
-        freq_ratio: case.ratio,
+/// The run specification of a case (default integrator).
+fn case_spec(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> RunSpec {
+    RunSpec {
+        alpha: Some(case.alpha),
+        friction: (!fixed_base).then_some(case.friction),
+        excitation: ExcitationSpec::ratio(case.ratio),
         duration: Some(duration),
-        dt,
+        dt: Some(dt),
         fixed_base,
-        ..RunRequest::default()
+        ..RunSpec::default()
     }
 }
 
@@ -257,36 +262,23 @@ fn record_every(dt: f64) -> usize {
 /// The DDA run of a case at the finest time step (the default scheme), to measure what
 /// the time step alone costs: as Δt → 0 every scheme tends to it, and it differs from the
 /// exact mass-spring solution only by the model (penalty springs at the joint).
-fn converged_dda(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> Result<TwoBlockRun> {
-    let req = case_request(case, duration, dt, fixed_base);
-    let setup = two_block_setup(&req)?;
+fn converged_dda(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> Result<ModelRun> {
+    let mut setup = case_spec(case, duration, dt, fixed_base).prepare()?;
+    setup.history = HistoryPlan::EverySteps(record_every(dt));
     let params = SolverParams {
         dt,
         duration,
         ..SolverParams::default()
     };
-    two_block::run_dda(&setup.scene, &setup.motion, params, record_every(dt))
+    simulate::run_dda(&setup, &setup.scene, params)
 }
 
-fn exact_reference(case: &Case, duration: f64, fixed_base: bool) -> Result<TwoBlockRun> {
-    let req = RunRequest {
-        alpha: case.alpha,
-        friction: case.friction,
-        freq_ratio: case.ratio,
-        duration: Some(duration),
-        fixed_base,
-        ..RunRequest::default()
+fn exact_reference(case: &Case, duration: f64, fixed_base: bool) -> Result<ModelRun> {
+    let spec = RunSpec {
+        dt: None,
+        ..case_spec(case, duration, crate::setup::defaults::DT, fixed_base)
     };
-    let setup = two_block_setup(&req)?;
-    two_block::run_exact(
-        case.alpha,
-        setup.roles.structure_frequency_hz,
-        setup.roles.total_mass,
-        setup.friction,
-        &setup.motion,
-        duration,
-        SAMPLE_DT,
-    )
+    simulate::run_exact_two_block(&spec.prepare()?, SAMPLE_DT)
 }
 
 /// Runs the study; `tick(done, total)` reports progress.
@@ -449,22 +441,22 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
     };
     if !frame_dts.is_empty() {
         for fixed_base in [false, true] {
-            let base = FrameRequest {
+            let base = RunSpec {
                 fixed_base,
                 duration: Some(15.0),
-                ..FrameRequest::default()
+                ..RunSpec::scene("three-storey")
             };
-            let converged = run_frame(&FrameRequest {
-                dt: 1e-4,
+            let converged = run_frame(&RunSpec {
+                dt: Some(1e-4),
                 ..base.clone()
             })?
             .summary;
             let mdof = run_mdof(&base)?.summary;
             for integ in [Integrator::Classic, Integrator::default()] {
                 for &dt in &frame_dts {
-                    let r = run_frame(&FrameRequest {
-                        dt,
-                        integrator: integ,
+                    let r = run_frame(&RunSpec {
+                        dt: Some(dt),
+                        integrator: Some(integ),
                         ..base.clone()
                     })?
                     .summary;
@@ -523,16 +515,8 @@ pub fn observed_order(points: &[(f64, f64)], floor: f64) -> Option<f64> {
 
 /// Writes `work_precision.csv`, the figures and `report.md`.
 pub fn write_accuracy(rows: &[AccuracyRow], out: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let csv_path = out.join("work_precision.csv");
-    let mut w = csv::Writer::from_path(&csv_path)
-        .map_err(|e| Error::Scene(format!("{}: {e}", csv_path.display())))?;
-    for r in rows {
-        w.serialize(r)
-            .map_err(|e| Error::Scene(format!("{}: {e}", csv_path.display())))?;
-    }
-    w.flush().map_err(|e| Error::io(&csv_path, e))?;
-    let mut files = vec![csv_path];
+    let mut staged = Staged::new(out)?;
+    staged.write_csv("work_precision.csv", rows)?;
     let labels: Vec<String> = {
         let mut v: Vec<String> = rows.iter().map(|r| r.integrator.clone()).collect();
         v.sort();
@@ -574,9 +558,7 @@ pub fn write_accuracy(rows: &[AccuracyRow], out: &Path) -> Result<Vec<PathBuf>> 
             ));
         }
     }
-    let path = out.join("work_precision.png");
-    fig.save_png(&path, 1400, 600)?;
-    files.push(path);
+    fig.save_png(&staged.path("work_precision.png"), 1400, 600)?;
     // Convergence: error against Δt, fixed base (smooth) and sliding (resonant case).
     let mut fig = Figure::new("Convergence with Δt", 1, 2);
     for (pi, (study, case_filter, title)) in [
@@ -628,13 +610,9 @@ pub fn write_accuracy(rows: &[AccuracyRow], out: &Path) -> Result<Vec<PathBuf>> 
             ));
         }
     }
-    let path = out.join("convergence.png");
-    fig.save_png(&path, 1400, 600)?;
-    files.push(path);
-    let md = out.join("report.md");
-    std::fs::write(&md, report_markdown(rows)).map_err(|e| Error::io(&md, e))?;
-    files.push(md);
-    Ok(files)
+    fig.save_png(&staged.path("convergence.png"), 1400, 600)?;
+    staged.write("report.md", report_markdown(rows))?;
+    staged.commit()
 }
 
 fn report_markdown(rows: &[AccuracyRow]) -> String {

@@ -12,14 +12,15 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::frame::{FrameRequest, run_frame};
-use super::run::{RunRequest, run};
+use super::frame::run_frame;
+use super::run::run;
 use super::sweep::{SweepRequest, parse_ratios, run_sweep};
-use super::two_block::ModelKind;
-use crate::dda::{Dda, Integrator, SolverParams};
+use crate::dda::{Dda, SolverParams};
 use crate::ground_motion::{GroundMotion, resolve_record};
 use crate::model::presets::resolve_scene;
+use crate::post::output::Staged;
 use crate::post::plot::{Figure, LegendCorner, Series};
+use crate::setup::{ModelKind, RunSpec};
 use crate::{Error, Result};
 
 /// What to measure.
@@ -179,11 +180,10 @@ fn measure(
 
 /// The paper's two-block model (α = 0.5, ρ = 0.1, resonance, 0.3 g, 100 s).
 fn two_block(model: ModelKind) -> Result<(f64, u64, f64)> {
-    let req = RunRequest {
+    let req = RunSpec {
         duration: Some(100.0),
-        record_every: 0,
         model,
-        ..RunRequest::default()
+        ..RunSpec::default()
     };
     let start = Instant::now();
     let o = run(&req)?;
@@ -192,9 +192,9 @@ fn two_block(model: ModelKind) -> Result<(f64, u64, f64)> {
 
 /// The three-storey frame on El Centro, Δt = 1 ms.
 fn three_storey(fixed_base: bool) -> Result<(f64, u64, f64)> {
-    let req = FrameRequest {
+    let req = RunSpec {
         fixed_base,
-        ..FrameRequest::default()
+        ..RunSpec::scene("three-storey")
     };
     let start = Instant::now();
     let o = run_frame(&req)?;
@@ -364,9 +364,10 @@ fn time_sweep(options: &BenchOptions) -> Result<SweepTiming> {
         frictions,
         freq_ratios: ratios,
         amplitude_g: 0.3,
-        duration: 100.0,
-        dt: 1e-3,
-        integrator: Integrator::default(),
+        duration: Some(100.0),
+        dt: None,
+        integrator: None,
+        confirm_large: false,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: None,
     };
@@ -460,23 +461,12 @@ pub fn report_text(r: &BenchReport) -> String {
 
 /// Writes `bench.json`, `scaling.csv` and `scaling.png` into `out`.
 pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let json = out.join("bench.json");
-    let text = serde_json::to_string_pretty(r)
-        .map_err(|e| Error::Scene(format!("cannot serialise the report: {e}")))?;
-    std::fs::write(&json, text).map_err(|e| Error::io(&json, e))?;
-    let mut files = vec![json];
+    let mut staged = Staged::new(out)?;
+    staged.write_json("bench.json", r)?;
     if r.scaling.is_empty() {
-        return Ok(files);
+        return staged.commit();
     }
-    let csv_path = out.join("scaling.csv");
-    let csv_error = |e: csv::Error| Error::Scene(format!("{}: {e}", csv_path.display()));
-    let mut w = csv::Writer::from_path(&csv_path).map_err(csv_error)?;
-    for p in &r.scaling {
-        w.serialize(p).map_err(csv_error)?;
-    }
-    w.flush().map_err(|e| Error::io(&csv_path, e))?;
-    files.push(csv_path);
+    staged.write_csv("scaling.csv", &r.scaling)?;
     let mut fig = Figure::new("Time per step against the size of the model", 1, 1);
     let p = &mut fig.panels[0];
     p.x_label = "unknowns (6 per block)".into();
@@ -532,10 +522,8 @@ pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
             .collect();
         p.series.push(Series::line("linear", x, y, 6));
     }
-    let png = out.join("scaling.png");
-    fig.save_png(&png, 1000, 700)?;
-    files.push(png);
-    Ok(files)
+    fig.save_png(&staged.path("scaling.png"), 1000, 700)?;
+    staged.commit()
 }
 
 #[cfg(test)]

@@ -5,14 +5,15 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::simulate::{self, ModelRun, SPECTRUM_DT, SPECTRUM_MAX_SAMPLES};
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
 use crate::dda::{Dda, Integrator, SolverParams};
-use crate::ground_motion::{GroundMotion, STANDARD_GRAVITY, resolve_record};
+use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::Scene;
-use crate::model::presets::resolve_scene;
 use crate::model::scene::{ExcitationDef, StructureRoles};
-use crate::post::history::{History, PeakTracker};
-use crate::post::spectrum::{fourier_amplitude, resample_uniform};
+use crate::post::history::History;
+use crate::post::spectrum::{UniformSeries, fourier_amplitude, resample_uniform};
+use crate::setup::{ModelKind, RunSetup, RunSpec};
 use crate::{Error, Result};
 
 /// The paper's natural frequencies of its three-storey frame, Hz.
@@ -43,6 +44,11 @@ pub struct ModesReport {
     pub shapes: Vec<Vec<f64>>,
     /// Names of the base and floors, in the order of the shapes.
     pub levels: Vec<String>,
+    /// For the equivalent MDOF model ([`equivalent_mdof`]): the largest relative
+    /// difference between its frequencies and the DDA frame's (0 up to rounding for
+    /// frames that behave as shear buildings, like the paper's; larger for tall frames,
+    /// whose overall bending no shear building has).
+    pub mdof_fit_error: Option<f64>,
 }
 
 /// Modal analysis of a building scene from the DDA stiffness and mass (fixed base: the
@@ -87,54 +93,25 @@ pub fn modes(scene: &Scene) -> Result<ModesReport> {
         frequencies_hz,
         shapes,
         levels,
+        mdof_fit_error: None,
     })
 }
 
-/// A run of a building scene.
-#[derive(Debug, Clone)]
-pub struct FrameRequest {
-    /// Built-in scene name or TOML path.
-    pub scene: String,
-    /// Record (built-in name or file); `None`: the scene's excitation.
-    pub record: Option<String>,
-    /// Friction coefficient of the sliding joint; `None`: the scene's.
-    pub friction: Option<f64>,
-    /// Fixed base: the joint is bonded.
-    pub fixed_base: bool,
-    /// Time step, s.
-    pub dt: f64,
-    /// Integrator.
-    pub integrator: Integrator,
-    /// Duration, s; `None`: the record's length.
-    pub duration: Option<f64>,
-}
-
-impl Default for FrameRequest {
-    fn default() -> Self {
-        Self {
-            scene: "three-storey".into(),
-            record: None,
-            friction: None,
-            fixed_base: false,
-            dt: 1e-3,
-            integrator: Integrator::default(),
-            duration: None,
-        }
-    }
-}
-
-/// Summary of a building run (the JSON object of `run --json`).
+/// Summary of a building run (the JSON object of `run --json`). A quantity that is
+/// undefined for the run is left out (never `null`), and `warnings` says why.
 #[derive(Debug, Clone, Serialize)]
 pub struct FrameSummary {
     /// Scene.
     pub scene: String,
     /// `dda` or `mass-spring` (the equivalent MDOF model).
     pub model: String,
-    /// Integrator.
-    pub integrator: String,
-    /// Record name.
+    /// Integrator (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<String>,
+    /// Record name (or the harmonic input).
     pub record: String,
-    /// Friction coefficient (null for a fixed base).
+    /// Friction coefficient (absent for a fixed base).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
     /// Fixed base.
     pub fixed_base: bool,
@@ -152,8 +129,10 @@ pub struct FrameSummary {
     pub peak_ground_accel_g: f64,
     /// Peak |roof displacement relative to the base|, m.
     pub peak_roof_drift_m: f64,
-    /// Frequency of the largest Fourier amplitude of the base acceleration, Hz.
-    pub base_accel_peak_freq_hz: f64,
+    /// Frequency of the largest Fourier amplitude of the base acceleration between 0.05
+    /// and 20 Hz (absent when the run is too short for a spectrum).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base_accel_peak_freq_hz: Option<f64>,
     /// Time steps.
     pub steps: u64,
     /// Open-close passes (DDA).
@@ -169,6 +148,8 @@ pub struct FrameSummary {
     pub energy_residual_rel: f64,
     /// Wall-clock time, s.
     pub wall_time_s: f64,
+    /// What the user should know: resolution, quantities left out and why.
+    pub warnings: Vec<String>,
 }
 
 /// A finished building run.
@@ -176,169 +157,108 @@ pub struct FrameSummary {
 pub struct FrameOutcome {
     /// Summary.
     pub summary: FrameSummary,
-    /// Histories: time_s, ground_accel, slip, base_accel, roof_accel, roof_drift (SI).
+    /// Histories, [`HISTORY_COLUMNS`] (SI), as the setup's history plan asked.
     pub history: History,
 }
 
-/// History columns of a building run.
-pub const FRAME_COLUMNS: [&str; 6] = [
-    "time_s",
-    "ground_accel_m_s2",
-    "slip_m",
-    "base_accel_m_s2",
-    "roof_accel_m_s2",
-    "roof_drift_m",
-];
-
-/// Loads the scene and motion of a request, applying friction, fixed base and record.
-pub fn prepare(req: &FrameRequest) -> Result<(Scene, StructureRoles, GroundMotion, f64)> {
-    crate::error::require_positive("--dt", req.dt)?;
-    let mut scene = resolve_scene(&req.scene)?;
-    let r = roles(&scene)?;
-    if let Some(f) = req.friction {
-        if f.is_nan() || f < 0.0 {
-            return Err(Error::invalid(
-                "--friction",
-                format!("must be >= 0, got {f}"),
-            ));
-        }
-        for c in scene.contacts.iter_mut().filter(|c| c.name == r.joint) {
-            c.friction = f;
-        }
-    }
-    if req.fixed_base {
-        for c in scene.contacts.iter_mut().filter(|c| c.name == r.joint) {
-            c.bonded = true;
-        }
-    }
-    let (record, scale) = match (&req.record, &scene.excitation) {
-        (Some(name), _) => (name.clone(), 1.0),
-        (None, ExcitationDef::Record { record, scale }) => (record.clone(), *scale),
-        (None, _) => {
-            return Err(Error::invalid(
-                "--record",
-                "the scene has no record; give one with --record",
-            ));
-        }
-    };
-    let mut rec = resolve_record(&record)?;
-    if scale != 1.0 {
-        rec = rec.scaled(scale)?;
-    }
-    let motion = GroundMotion::Record(std::sync::Arc::new(rec));
-    let duration = match req.duration {
-        Some(d) => crate::error::require_positive("--duration", d)?,
-        None => motion.duration().unwrap_or(30.0),
-    };
-    Ok((scene, r, motion, duration))
+/// Writes a building run's history and summary into `dir` (all or nothing).
+pub fn write_outputs(
+    outcome: &FrameOutcome,
+    dir: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>> {
+    let mut staged = crate::post::output::Staged::new(dir)?;
+    outcome.history.write_csv(&staged.path("history.csv"))?;
+    staged.write_json("summary.json", &outcome.summary)?;
+    staged.commit()
 }
 
-/// Runs the DDA model of a building scene.
-pub fn run_frame(req: &FrameRequest) -> Result<FrameOutcome> {
-    let (scene, r, motion, duration) = prepare(req)?;
-    let start = Instant::now();
-    let params = SolverParams {
-        dt: req.dt,
-        duration,
-        integrator: req.integrator,
-        ..SolverParams::default()
-    };
-    let mut dda = Dda::new(&scene, Some(motion.clone()), params)?;
-    let base = dda.block_index(&r.base)?;
-    let roof = dda.block_index(r.floors.last().map_or(&r.base, |s| s))?;
-    let mut history = History::new(&FRAME_COLUMNS);
-    let (mut slip_pk, mut base_pk, mut roof_pk, mut drift_pk) = Default::default();
-    let mut last_slip = 0.0;
-    dda.run_until(duration, |d, _| {
-        let t = d.time();
-        let b = &d.blocks()[base];
-        let top = &d.blocks()[roof];
-        let slip = b.centroid_displacement()[0] - motion.displacement(t);
-        let drift = top.centroid_displacement()[0] - b.centroid_displacement()[0];
-        PeakTracker::offer(&mut slip_pk, t, slip);
-        PeakTracker::offer(&mut base_pk, t, b.accel[0]);
-        PeakTracker::offer(&mut roof_pk, t, top.accel[0]);
-        PeakTracker::offer(&mut drift_pk, t, drift);
-        history.push(&[t, motion.accel(t), slip, b.accel[0], top.accel[0], drift]);
-        last_slip = slip;
-    })?;
-    let counters = dda.counters();
-    let summary = summarise(
-        &scene,
-        "dda",
-        req,
-        &motion,
-        duration,
-        &history,
-        [slip_pk, base_pk, roof_pk, drift_pk],
-        last_slip,
-        counters.steps,
-        start,
-    )?;
+/// Runs a building scene with the model the specification names (DDA or the equivalent
+/// MDOF mass-spring model).
+pub fn run_building(spec: &RunSpec) -> Result<FrameOutcome> {
+    let setup = spec.prepare()?;
+    run_building_setup(&setup)
+}
+
+/// Runs a prepared building setup.
+pub fn run_building_setup(setup: &RunSetup) -> Result<FrameOutcome> {
+    if setup.two_block().is_some() {
+        return Err(Error::invalid(
+            "--scene",
+            format!(
+                "scene '{}' is a two-block scene, not a building (no [structure] section)",
+                setup.scene.name
+            ),
+        ));
+    }
+    match setup.model {
+        ModelKind::Dda => run_frame_setup(setup),
+        ModelKind::MassSpring => run_mdof_setup(setup),
+    }
+}
+
+/// Runs the DDA model of a building scene (whatever model the specification names).
+pub fn run_frame(spec: &RunSpec) -> Result<FrameOutcome> {
+    run_frame_setup(&spec.prepare()?)
+}
+
+fn run_frame_setup(setup: &RunSetup) -> Result<FrameOutcome> {
+    let run = simulate::run_dda(setup, &setup.scene, setup.solver_params())?;
+    let series = run.base_accel_series.clone();
+    let summary = summarise(setup, ModelKind::Dda, &run, series)?;
+    super::run::check_finite(&summary, setup.duration)?;
     Ok(FrameOutcome {
-        summary: FrameSummary {
-            open_close_passes: counters.passes,
-            dt_cuts: counters.cuts,
-            factorizations: counters.factorizations,
-            max_penetration_ratio: counters.max_penetration_ratio,
-            energy_residual_rel: dda.energy_residual_relative(),
-            ..summary
-        },
-        history,
+        summary,
+        history: run.history,
     })
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The summary of a building run from its peaks and the resampled base acceleration.
 fn summarise(
-    scene: &Scene,
-    model: &str,
-    req: &FrameRequest,
-    motion: &GroundMotion,
-    duration: f64,
-    history: &History,
-    peaks: [PeakTracker; 4],
-    residual_slip: f64,
-    steps: u64,
-    start: Instant,
+    setup: &RunSetup,
+    model: ModelKind,
+    run: &ModelRun,
+    base_accel: Option<UniformSeries>,
 ) -> Result<FrameSummary> {
-    let t = history.column("time_s").unwrap_or_default();
-    let a = history.column("base_accel_m_s2").unwrap_or_default();
-    let fft_dt = 0.005;
-    let uniform = resample_uniform(t, a, fft_dt)?;
-    let peak_freq = fourier_amplitude(&uniform, fft_dt)?
-        .peak(0.05, 20.0)
-        .map_or(f64::NAN, |p| p.0);
-    let [slip, base, roof, drift] = peaks;
+    let mut warnings = setup.warnings.clone();
+    let peak_freq = base_accel.and_then(|series| {
+        let (samples, dt) = series.finish();
+        let peak = fourier_amplitude(&samples, dt)
+            .ok()
+            .and_then(|s| s.peak(0.05, 20.0))
+            .map(|p| p.0);
+        if peak.is_none() {
+            warnings.push(format!(
+                "the run ({} s) is too short for a spectrum of the base acceleration: \
+                 base_accel_peak_freq_hz is left out",
+                setup.duration
+            ));
+        }
+        peak
+    });
+    let p = &run.peaks;
     Ok(FrameSummary {
-        scene: scene.name.clone(),
-        model: model.into(),
-        integrator: req.integrator.label(),
-        record: motion.label(),
-        friction: if req.fixed_base {
-            None
-        } else {
-            scene
-                .structure
-                .as_ref()
-                .and_then(|r| scene.contacts.iter().find(|c| c.name == r.joint))
-                .map(|c| c.friction)
-        },
-        fixed_base: req.fixed_base,
-        duration_s: duration,
-        max_slip_m: slip.value,
-        residual_slip_m: residual_slip,
-        peak_roof_accel_g: roof.value / STANDARD_GRAVITY,
-        peak_base_accel_g: base.value / STANDARD_GRAVITY,
-        peak_ground_accel_g: motion.peak_accel(duration) / STANDARD_GRAVITY,
-        peak_roof_drift_m: drift.value,
+        scene: setup.scene.name.clone(),
+        model: model.label().into(),
+        integrator: (model == ModelKind::Dda).then(|| setup.integrator.label()),
+        record: setup.motion.label(),
+        friction: super::run::reported_friction(setup, &mut warnings),
+        fixed_base: setup.fixed_base,
+        duration_s: setup.duration,
+        max_slip_m: p.slip_m,
+        residual_slip_m: run.residual_slip_m,
+        peak_roof_accel_g: p.roof_accel / STANDARD_GRAVITY,
+        peak_base_accel_g: p.base_accel / STANDARD_GRAVITY,
+        peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
+        peak_roof_drift_m: p.drift_m,
         base_accel_peak_freq_hz: peak_freq,
-        steps,
-        open_close_passes: 0,
-        dt_cuts: 0,
-        factorizations: 0,
-        max_penetration_ratio: 0.0,
-        energy_residual_rel: 0.0,
-        wall_time_s: start.elapsed().as_secs_f64(),
+        steps: run.steps,
+        open_close_passes: run.passes,
+        dt_cuts: run.cuts,
+        factorizations: run.factorizations,
+        max_penetration_ratio: run.max_penetration_ratio,
+        energy_residual_rel: run.energy_residual_rel,
+        wall_time_s: run.wall_time_s,
+        warnings,
     })
 }
 
@@ -346,8 +266,31 @@ fn summarise(
 /// DDA blocks (each slab plus half of the columns above and below it), storey stiffnesses
 /// fitted so that the shear building has the DDA frame's natural frequencies.
 pub fn equivalent_mdof(scene: &Scene) -> Result<(ShearBuilding, ModesReport)> {
+    equivalent_mdof_with(scene, modes(scene)?)
+}
+
+/// [`equivalent_mdof`] from the scene's modes already computed.
+pub fn equivalent_mdof_with(
+    scene: &Scene,
+    report: ModesReport,
+) -> Result<(ShearBuilding, ModesReport)> {
     let r = roles(scene)?;
-    let report = modes(scene)?;
+    if let Some(f) = report
+        .frequencies_hz
+        .iter()
+        .find(|f| f.partial_cmp(&&0.0) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(Error::invalid(
+            "--scene",
+            format!(
+                "the fixed-base frame of '{}' has a sway mode of frequency {f} Hz: under its \
+                 own weight it is at or past its buckling load (the geometric P-Δ softening \
+                 of the gravity load cancels the columns' stiffness), so no shear building \
+                 is equivalent to it; run it with --model dda",
+                scene.name
+            ),
+        ));
+    }
     let dda = Dda::new(scene, None, SolverParams::default())?;
     let level_names: Vec<&str> = std::iter::once(r.base.as_str())
         .chain(r.floors.iter().map(String::as_str))
@@ -385,7 +328,11 @@ pub fn equivalent_mdof(scene: &Scene) -> Result<(ShearBuilding, ModesReport)> {
         .find(|c| c.name == r.joint)
         .map_or(0.0, |c| c.friction);
     let storey_masses = masses[1..].to_vec();
-    let stiffnesses = fit_storey_stiffnesses(&storey_masses, &report.frequencies_hz)?;
+    let (stiffnesses, fit_error) = fit_storey_stiffnesses(&storey_masses, &report.frequencies_hz)?;
+    let report = ModesReport {
+        mdof_fit_error: Some(fit_error),
+        ..report
+    };
     let building = ShearBuilding {
         storey_masses,
         storey_stiffnesses: stiffnesses,
@@ -398,8 +345,11 @@ pub fn equivalent_mdof(scene: &Scene) -> Result<(ShearBuilding, ModesReport)> {
 }
 
 /// Storey stiffnesses of a shear building with these floor masses whose fixed-base
-/// frequencies are `target_hz` (Newton's method on log k, from a uniform guess).
-fn fit_storey_stiffnesses(masses: &[f64], target_hz: &[f64]) -> Result<Vec<f64>> {
+/// frequencies are `target_hz`, and the largest relative frequency mismatch left:
+/// Levenberg–Marquardt on ln f(ln k), from a uniform guess. A frame that is a shear
+/// building is matched to rounding; one that is not (a tall frame bends as a whole) gets
+/// the shear building nearest to it in the least-squares sense of the log frequencies.
+fn fit_storey_stiffnesses(masses: &[f64], target_hz: &[f64]) -> Result<(Vec<f64>, f64)> {
     let n = masses.len();
     if target_hz.len() < n {
         return Err(Error::Solver {
@@ -420,6 +370,14 @@ fn fit_storey_stiffnesses(masses: &[f64], target_hz: &[f64]) -> Result<Vec<f64>>
         }
         .fixed_base_frequencies_hz()
     };
+    let residuals = |k: &[f64]| -> Option<Vec<f64>> {
+        let f = freqs(k);
+        let r: Vec<f64> = (0..n)
+            .map(|i| Some(f.get(i)?.ln() - target_hz[i].ln()))
+            .collect::<Option<_>>()?;
+        r.iter().all(|x| x.is_finite()).then_some(r)
+    };
+    let cost = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
     // Uniform guess from the first mode.
     let w1 = 2.0 * std::f64::consts::PI * target_hz[0];
     let mut k: Vec<f64> = vec![w1 * w1 * masses.iter().sum::<f64>() / n as f64 * 2.0; n];
@@ -427,97 +385,128 @@ fn fit_storey_stiffnesses(masses: &[f64], target_hz: &[f64]) -> Result<Vec<f64>>
     for v in &mut k {
         *v *= scale0 * scale0;
     }
-    for _ in 0..50 {
-        let f = freqs(&k);
-        let res: Vec<f64> = (0..n).map(|i| f[i].ln() - target_hz[i].ln()).collect();
+    let mut res = residuals(&k).ok_or_else(|| Error::Solver {
+        time: 0.0,
+        reason: "the storey-stiffness fit has no valid starting point".into(),
+    })?;
+    let mut lambda = 1e-3;
+    for _ in 0..200 {
         if res.iter().all(|r| r.abs() < 1e-12) {
             break;
         }
         // Jacobian d ln f / d ln k by finite differences.
+        let h = 1e-6_f64;
         let mut jac = nalgebra::DMatrix::zeros(n, n);
         for j in 0..n {
             let mut kp = k.clone();
-            kp[j] *= 1.0 + 1e-6;
-            let fp = freqs(&kp);
+            kp[j] *= 1.0 + h;
+            let Some(rp) = residuals(&kp) else { continue };
             for i in 0..n {
-                jac[(i, j)] = (fp[i].ln() - f[i].ln()) / (1e-6_f64).ln_1p();
+                jac[(i, j)] = (rp[i] - res[i]) / h.ln_1p();
             }
         }
-        let rhs = nalgebra::DVector::from_iterator(n, res.iter().map(|r| -r));
-        let step = jac.lu().solve(&rhs).ok_or_else(|| Error::Solver {
-            time: 0.0,
-            reason: "the storey-stiffness fit is singular".into(),
-        })?;
-        for j in 0..n {
-            k[j] *= step[j].clamp(-0.5, 0.5).exp();
+        let jt = jac.transpose();
+        let g = &jt * nalgebra::DVector::from_column_slice(&res);
+        let jtj = &jt * &jac;
+        let mut improved = false;
+        for _ in 0..20 {
+            let mut a = jtj.clone();
+            for d in 0..n {
+                a[(d, d)] += lambda * (1.0 + jtj[(d, d)]);
+            }
+            let Some(step) = a.lu().solve(&(-&g)) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let trial: Vec<f64> = (0..n)
+                .map(|j| k[j] * step[j].clamp(-0.5, 0.5).exp())
+                .collect();
+            if let Some(r) = residuals(&trial)
+                && cost(&r) < cost(&res)
+            {
+                (k, res) = (trial, r);
+                lambda = (lambda * 0.3).max(1e-12);
+                improved = true;
+                break;
+            }
+            lambda *= 10.0;
+        }
+        if !improved {
+            break;
         }
     }
     let f = freqs(&k);
-    if (0..n).any(|i| (f[i] / target_hz[i] - 1.0).abs() > 1e-6) {
+    let error = (0..n)
+        .map(|i| (f[i] / target_hz[i] - 1.0).abs())
+        .fold(0.0, f64::max);
+    if !error.is_finite() || k.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
         return Err(Error::Solver {
             time: 0.0,
-            reason: format!("no shear building has the frequencies {target_hz:?} (best fit {f:?})"),
+            reason: format!("no shear building was found near the frequencies {target_hz:?}"),
         });
     }
-    Ok(k)
+    Ok((k, error))
 }
 
-/// Runs the equivalent MDOF mass-spring model of a building scene on the same record.
-pub fn run_mdof(req: &FrameRequest) -> Result<FrameOutcome> {
-    let (scene, _, motion, duration) = prepare(req)?;
+/// A fit of the equivalent shear building to the DDA frequencies within this relative
+/// error is exact for every purpose; beyond it, runs and `modes` say how close it is.
+pub const MDOF_FIT_TOLERANCE: f64 = 1e-6;
+
+/// The warning of an inexact equivalent shear building.
+pub fn mdof_fit_warning(error: f64) -> String {
+    format!(
+        "no shear building has exactly the DDA frame's frequencies (the frame bends as a \
+         whole); the equivalent MDOF model is the nearest one, its frequencies within {:.2} %",
+        100.0 * error
+    )
+}
+
+/// Output interval of the MDOF model's time history, s: the base-acceleration spectrum is
+/// computed from it.
+const MDOF_OUTPUT_DT: f64 = 0.002;
+
+/// Runs the equivalent MDOF mass-spring model of a building scene (whatever model the
+/// specification names).
+pub fn run_mdof(spec: &RunSpec) -> Result<FrameOutcome> {
+    run_mdof_setup(&spec.prepare()?)
+}
+
+fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
     let start = Instant::now();
-    let (mut building, _) = equivalent_mdof(&scene)?;
-    if req.fixed_base {
+    let (mut building, report) = equivalent_mdof(&setup.scene)?;
+    let mut setup = setup.clone();
+    if let Some(e) = report.mdof_fit_error.filter(|&e| e > MDOF_FIT_TOLERANCE) {
+        setup.warnings.push(mdof_fit_warning(e));
+    }
+    let setup = &setup;
+    if setup.fixed_base {
         building.friction = f64::INFINITY;
     }
-    let out_dt = 0.002;
+    let motion = &setup.motion;
     let r = simulate(
         &building,
-        &motion,
-        duration,
-        out_dt,
+        motion,
+        setup.duration,
+        simulate::exact_output_dt(MDOF_OUTPUT_DT, setup.duration),
         &ExactOptions::default(),
     )?;
-    let top = building.storey_masses.len() - 1;
-    let mut history = History::new(&FRAME_COLUMNS);
-    for k in 0..r.time.len() {
-        let t = r.time[k];
-        history.push(&[
-            t,
-            motion.accel(t),
-            r.slip[k],
-            r.raft_accel[k],
-            r.storey_accel[top][k],
-            r.storey_drift[top][k],
-        ]);
+    let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
+    for (&t, &a) in r.time.iter().zip(&r.raft_accel) {
+        series.push(t, a);
     }
-    let pk = |v: f64| PeakTracker {
-        value: v,
-        time: 0.0,
-    };
-    let mut summary = summarise(
-        &scene,
-        "mass-spring",
-        req,
-        &motion,
-        duration,
-        &history,
-        [
-            pk(r.peaks.slip),
-            pk(r.peaks.raft_accel),
-            pk(r.peaks.roof_accel),
-            pk(r.peaks.roof_drift),
-        ],
-        r.residual_slip,
-        r.steps,
-        start,
-    )?;
-    summary.energy_residual_rel = if r.energy.input_work != 0.0 {
+    let residual = if r.energy.input_work != 0.0 {
         r.energy.residual / r.energy.input_work
     } else {
         0.0
     };
-    Ok(FrameOutcome { summary, history })
+    let keep = setup.history.stride() > 0;
+    let run = simulate::exact_model_run(&r, motion, keep, 1.0, residual, start);
+    let summary = summarise(setup, ModelKind::MassSpring, &run, Some(series))?;
+    super::run::check_finite(&summary, setup.duration)?;
+    Ok(FrameOutcome {
+        summary,
+        history: run.history,
+    })
 }
 
 /// Natural frequencies measured from a free-vibration run of the fixed-base frame (an

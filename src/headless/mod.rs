@@ -8,6 +8,6 @@ pub mod bench;
 pub mod frame;
 pub mod report;
 pub mod run;
+pub mod simulate;
 pub mod stability;
 pub mod sweep;
-pub mod two_block;

@@ -5,15 +5,15 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::frame::{
-    FrameOutcome, FrameRequest, PAPER_FREQUENCIES_HZ, equivalent_mdof, run_frame, run_mdof,
-};
+use super::frame::{FrameOutcome, PAPER_FREQUENCIES_HZ, equivalent_mdof, run_frame, run_mdof};
+use crate::Result;
 use crate::dda::Integrator;
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::presets::resolve_scene;
+use crate::post::output::Staged;
 use crate::post::plot::{Figure, Series};
 use crate::post::spectrum::{Spectrum, fourier_amplitude, resample_uniform};
-use crate::{Error, Result};
+use crate::setup::{ExcitationSpec, HistoryPlan, RunSpec};
 
 /// What `report` needs.
 #[derive(Debug, Clone)]
@@ -24,10 +24,12 @@ pub struct ReportRequest {
     pub record: Option<String>,
     /// Friction of the sliding joint; `None`: the scene's.
     pub friction: Option<f64>,
-    /// Time step, s.
-    pub dt: f64,
+    /// Time step, s; `None`: the run set-up's default.
+    pub dt: Option<f64>,
     /// Duration, s; `None`: the record's length.
     pub duration: Option<f64>,
+    /// Run even beyond the step limit.
+    pub confirm_large: bool,
 }
 
 /// The runs of a report.
@@ -47,22 +49,39 @@ pub struct ReportRuns {
     pub mdof_fixed: FrameOutcome,
 }
 
+impl ReportRequest {
+    /// The run specification of the sliding DDA run (the others vary it).
+    pub fn spec(&self) -> RunSpec {
+        RunSpec {
+            excitation: self
+                .record
+                .clone()
+                .map_or(ExcitationSpec::Scene, ExcitationSpec::record),
+            friction: self.friction,
+            dt: self.dt,
+            duration: self.duration,
+            confirm_large: self.confirm_large,
+            // The figures show every step.
+            history: HistoryPlan::EverySteps(1),
+            ..RunSpec::scene(self.scene.as_str())
+        }
+    }
+}
+
 /// Runs everything a report shows.
 pub fn run_all(req: &ReportRequest) -> Result<ReportRuns> {
-    let base = FrameRequest {
-        scene: req.scene.clone(),
-        record: req.record.clone(),
-        friction: req.friction,
-        dt: req.dt,
-        duration: req.duration,
-        ..FrameRequest::default()
-    };
-    let fixed = FrameRequest {
+    let base = req.spec();
+    let fixed = RunSpec {
         fixed_base: true,
         ..base.clone()
     };
-    let classic = |r: &FrameRequest| FrameRequest {
-        integrator: Integrator::Classic,
+    let classic = |r: &RunSpec| RunSpec {
+        integrator: Some(Integrator::Classic),
+        ..r.clone()
+    };
+    // The exact model has no time step: its history is sampled at its own interval.
+    let mdof = |r: &RunSpec| RunSpec {
+        dt: None,
         ..r.clone()
     };
     Ok(ReportRuns {
@@ -70,8 +89,8 @@ pub fn run_all(req: &ReportRequest) -> Result<ReportRuns> {
         fixed: run_frame(&fixed)?,
         sliding_classic: run_frame(&classic(&base))?,
         fixed_classic: run_frame(&classic(&fixed))?,
-        mdof_sliding: run_mdof(&base)?,
-        mdof_fixed: run_mdof(&fixed)?,
+        mdof_sliding: run_mdof(&mdof(&base))?,
+        mdof_fixed: run_mdof(&mdof(&fixed))?,
     })
 }
 
@@ -124,14 +143,9 @@ fn spectrum_series(s: &Spectrum, label: &str, color: usize, f_max: f64) -> Serie
 
 /// Writes the figures (fig10…fig18) and `summary.md` into `out`; returns the files.
 pub fn write_report(req: &ReportRequest, runs: &ReportRuns, out: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let mut files = Vec::new();
-    let mut save = |name: &str, fig: Figure| -> Result<()> {
-        let path = out.join(name);
-        fig.save_png(&path, 1200, 520)?;
-        files.push(path);
-        Ok(())
-    };
+    let mut staged = Staged::new(out)?;
+    let mut save =
+        |name: &str, fig: Figure| -> Result<()> { fig.save_png(&staged.path(name), 1200, 520) };
     let (s, f) = (&runs.sliding, &runs.fixed);
     let (ms, mf) = (&runs.mdof_sliding, &runs.mdof_fixed);
     let t = column(s, "time_s");
@@ -149,11 +163,7 @@ pub fn write_report(req: &ReportRequest, runs: &ReportRuns, out: &Path) -> Resul
     )?;
     // The record's own samples (not the solver's history, resampled): its spectrum has
     // three nearly equal peaks (1.50, 2.14, 1.18 Hz), and interpolation reorders them.
-    let (_, _, motion, _) = super::frame::prepare(&FrameRequest {
-        scene: req.scene.clone(),
-        record: req.record.clone(),
-        ..FrameRequest::default()
-    })?;
+    let motion = req.spec().prepare()?.motion;
     let g_spec = match &motion {
         crate::ground_motion::GroundMotion::Record(r) => fourier_amplitude(r.samples(), r.dt)?,
         _ => spectrum_of(s, "ground_accel_m_s2")?,
@@ -227,8 +237,11 @@ pub fn write_report(req: &ReportRequest, runs: &ReportRuns, out: &Path) -> Resul
                 spectrum_series(&g_spec, "ground", 6, 10.0),
             ],
             vec![format!(
-                "highest peak {:.2} Hz; below 1 Hz: {:.2} Hz (paper: about 0.35 Hz)",
-                s.summary.base_accel_peak_freq_hz, b_low.0
+                "highest peak {} Hz; below 1 Hz: {:.2} Hz (paper: about 0.35 Hz)",
+                s.summary
+                    .base_accel_peak_freq_hz
+                    .map_or("–".to_string(), |f| format!("{f:.2}")),
+                b_low.0
             )],
         ),
     )?;
@@ -307,10 +320,8 @@ pub fn write_report(req: &ReportRequest, runs: &ReportRuns, out: &Path) -> Resul
         ),
     )?;
     let summary = summary_markdown(req, runs, g_peak.0, b_low.0)?;
-    let md = out.join("summary.md");
-    std::fs::write(&md, summary).map_err(|e| Error::io(&md, e))?;
-    files.push(md);
-    Ok(files)
+    staged.write("summary.md", summary)?;
+    staged.commit()
 }
 
 /// The summary table: each quantity from DDA (both integrators), the MDOF model and the paper.
@@ -338,7 +349,7 @@ pub fn summary_markdown(
         format!(
             "Friction ρ = {}, Δt = {} s, {:.2} s of record. DDA with generalised-α (ρ∞ = 0, the default) and with the classic DDA update (the paper's); MDOF = the equivalent shear building on a sliding raft (floor masses from the blocks, storey stiffnesses fitted to the DDA frequencies), solved exactly.\n",
             r.sliding.summary.friction.unwrap_or(f64::NAN),
-            req.dt,
+            req.dt.unwrap_or(crate::setup::defaults::DT),
             r.sliding.summary.duration_s
         ),
     );
@@ -405,9 +416,9 @@ pub fn summary_markdown(
     row(
         &mut s,
         "base accel. spectrum, highest peak (Hz)",
-        sl.base_accel_peak_freq_hz,
-        slc.base_accel_peak_freq_hz,
-        ms.base_accel_peak_freq_hz,
+        sl.base_accel_peak_freq_hz.unwrap_or(f64::NAN),
+        slc.base_accel_peak_freq_hz.unwrap_or(f64::NAN),
+        ms.base_accel_peak_freq_hz.unwrap_or(f64::NAN),
         "–",
     );
     row(

@@ -1,83 +1,36 @@
 //! `slidebase run`: one simulation of a scene, summarised in the paper's terms.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::two_block::{self, ModelKind, TwoBlockRun};
-use crate::dda::{Integrator, SolverParams};
-use crate::ground_motion::{GroundMotion, Harmonic, STANDARD_GRAVITY, resolve_record};
-use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground, resolve_scene};
-use crate::model::scene::{ExcitationDef, GroundKind};
+use super::simulate::{self, ModelRun};
+use crate::ground_motion::STANDARD_GRAVITY;
+use crate::post::output::Staged;
+use crate::setup::{ModelKind, RunSetup, RunSpec, defaults};
 use crate::{Error, Result};
 
-/// Everything a run needs; the command-line flags map one to one onto these fields.
-#[derive(Debug, Clone)]
-pub struct RunRequest {
-    /// Built-in scene name or TOML path.
-    pub scene: String,
-    /// Mass ratio α = m/(M + m) (two-mass scenes).
-    pub alpha: f64,
-    /// Friction coefficient ρ of the sliding joint.
-    pub friction: f64,
-    /// Ω/ω of the harmonic excitation (two-mass scenes).
-    pub freq_ratio: f64,
-    /// Amplitude of the harmonic excitation, g.
-    pub amplitude_g: f64,
-    /// Duration, s; `None`: 100 s for harmonic input (the paper's), the record's length otherwise.
-    pub duration: Option<f64>,
-    /// Time step, s.
-    pub dt: f64,
-    /// Integrator.
-    pub integrator: Integrator,
-    /// DDA or the exact mass-spring model.
-    pub model: ModelKind,
-    /// Fixed base: the joint never slides.
-    pub fixed_base: bool,
-    /// A record (built-in name or file) instead of harmonic input.
-    pub record: Option<String>,
-    /// Ground model for DDA (None: the scene's).
-    pub ground: Option<GroundKind>,
-    /// Keep every n-th step in the recorded history.
-    pub record_every: usize,
-}
-
-impl Default for RunRequest {
-    fn default() -> Self {
-        Self {
-            scene: "two-block".into(),
-            alpha: 0.5,
-            friction: 0.1,
-            freq_ratio: 1.0,
-            amplitude_g: 0.3,
-            duration: None,
-            dt: 1e-3,
-            integrator: Integrator::default(),
-            model: ModelKind::Dda,
-            fixed_base: false,
-            record: None,
-            ground: None,
-            record_every: 10,
-        }
-    }
-}
-
-/// The one-object summary printed by `--json` and written by `--out`.
+/// The one-object summary printed by `--json` and written by `--out`. A quantity that is
+/// undefined for the run is left out (never `null`, NaN or inf); `warnings` says why when
+/// it is not obvious, and what else the user should know.
 #[derive(Debug, Clone, Serialize)]
 pub struct RunSummary {
     /// Scene name.
     pub scene: String,
     /// `dda` or `mass-spring`.
     pub model: String,
-    /// Integrator (DDA).
-    pub integrator: String,
+    /// Integrator (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<String>,
     /// Mass ratio α.
     pub alpha: f64,
-    /// Friction coefficient ρ (null when the base is fixed).
+    /// Friction coefficient ρ (absent when the base is fixed).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
     /// Whether the base was fixed.
     pub fixed_base: bool,
     /// Ω/ω (harmonic input only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub freq_ratio: Option<f64>,
     /// Excitation: `harmonic` or the record name.
     pub excitation: String,
@@ -85,16 +38,21 @@ pub struct RunSummary {
     pub amplitude_g: f64,
     /// Duration, s.
     pub duration_s: f64,
-    /// Nominal time step, s.
-    pub dt_s: f64,
+    /// Nominal time step, s (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dt_s: Option<f64>,
     /// max|u_s| / D with D = a_max/Ω² (harmonic input only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub us_max_over_d: Option<f64>,
     /// max|u_r| / D (harmonic input only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ur_max_over_d: Option<f64>,
-    /// max|a_base| / a_max (absolute accelerations).
-    pub abase_over_aground: f64,
-    /// max|a_roof| / a_max.
-    pub aroof_over_aground: f64,
+    /// max|a_base| / a_max (absolute accelerations; absent when a_max = 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub abase_over_aground: Option<f64>,
+    /// max|a_roof| / a_max (absent when a_max = 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub aroof_over_aground: Option<f64>,
     /// max|u_s|, m.
     pub us_max_m: f64,
     /// max|u_r|, m.
@@ -117,6 +75,8 @@ pub struct RunSummary {
     pub friction_dissipated_j: f64,
     /// Wall-clock time of the solve, s.
     pub wall_time_s: f64,
+    /// What the user should know: resolution, quantities left out and why.
+    pub warnings: Vec<String>,
 }
 
 /// A finished run: summary and histories.
@@ -125,164 +85,64 @@ pub struct RunOutcome {
     /// The summary.
     pub summary: RunSummary,
     /// The full result (histories).
-    pub run: TwoBlockRun,
+    pub run: ModelRun,
 }
 
-/// The scene and motion of a two-mass request, ready to run.
-#[derive(Debug, Clone)]
-pub struct TwoBlockSetup {
-    /// The scene with α, ρ, Ω/ω, ground and fixed base applied.
-    pub scene: crate::model::Scene,
-    /// The ground motion.
-    pub motion: GroundMotion,
-    /// Duration, s.
-    pub duration: f64,
-    /// Ω/ω (harmonic input only).
-    pub freq_ratio: Option<f64>,
-    /// `harmonic` or the record name.
-    pub excitation: String,
-    /// The scene's two-mass roles.
-    pub roles: crate::model::scene::TwoBlockRoles,
-    /// Friction actually used (∞ for a fixed base).
-    pub friction: f64,
+/// Runs one two-mass simulation as specified.
+pub fn run(spec: &RunSpec) -> Result<RunOutcome> {
+    let setup = spec.prepare()?;
+    run_setup(&setup)
 }
 
-/// Builds the scene and motion of a two-mass request (shared by `run`, the accuracy and
-/// stability studies).
-pub fn two_block_setup(req: &RunRequest) -> Result<TwoBlockSetup> {
-    crate::error::require_positive("--dt", req.dt)?;
-    if let Some(d) = req.duration {
-        crate::error::require_positive("--duration", d)?;
-    }
-    let friction = if req.fixed_base {
-        f64::INFINITY
-    } else {
-        req.friction
-    };
-    let params = TwoBlockParams {
-        alpha: req.alpha,
-        friction,
-        freq_ratio: req.freq_ratio,
-        amplitude_g: req.amplitude_g,
-    };
-    params.validate()?;
-    let mut scene = resolve_scene(&req.scene)?;
-    let roles = scene.two_block.clone().ok_or_else(|| {
+/// Runs a prepared two-mass setup.
+pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
+    let (roles, alpha, freq_ratio) = setup.two_block().ok_or_else(|| {
         Error::invalid(
             "--scene",
             format!(
                 "scene '{}' is not a two-mass scene (no [two_block] section)",
-                scene.name
+                setup.scene.name
             ),
         )
     })?;
-    apply_two_block(&mut scene, &params)?;
     let structure_hz = roles.structure_frequency_hz;
-    let (motion, omega_ratio, excitation) = match &req.record {
-        None => {
-            let h = Harmonic::from_g_hz(req.amplitude_g, req.freq_ratio * structure_hz)?;
-            (
-                GroundMotion::Harmonic(h),
-                Some(req.freq_ratio),
-                "harmonic".to_string(),
-            )
-        }
-        Some(name) => {
-            let r = resolve_record(name)?;
-            let label = r.name.clone();
-            scene.excitation = ExcitationDef::Record {
-                record: name.clone(),
-                scale: 1.0,
-            };
-            (GroundMotion::Record(std::sync::Arc::new(r)), None, label)
+    let duration = setup.duration;
+    let a_max = setup.motion.peak_accel(duration);
+    let run = match setup.model {
+        ModelKind::Dda => simulate::run_dda(setup, &setup.scene, setup.solver_params())?,
+        ModelKind::MassSpring => {
+            simulate::run_exact_two_block(setup, setup.dt * setup.history.stride() as f64)?
         }
     };
-    let duration = match (req.duration, motion.duration()) {
-        (Some(d), _) => d,
-        (None, Some(d)) => d,
-        (None, None) => 100.0,
-    };
-    // The raft can slide as far as the ground moves: make sure the ground is long enough.
-    let travel = max_abs_displacement(&motion, duration);
-    extend_ground(&mut scene, 1.2 * travel + 10.0)?;
-    if req.fixed_base {
-        for c in &mut scene.contacts {
-            if c.name == roles.joint {
-                c.bonded = true;
-            }
-        }
-    }
-    if let Some(kind) = req.ground {
-        scene.ground.kind = kind;
-    }
-    Ok(TwoBlockSetup {
-        scene,
-        motion,
-        duration,
-        freq_ratio: omega_ratio,
-        excitation,
-        roles,
-        friction,
-    })
-}
-
-/// Runs one two-mass simulation as requested.
-pub fn run(req: &RunRequest) -> Result<RunOutcome> {
-    let TwoBlockSetup {
-        scene,
-        motion,
-        duration,
-        freq_ratio: omega_ratio,
-        excitation,
-        roles,
-        friction,
-    } = two_block_setup(req)?;
-    let structure_hz = roles.structure_frequency_hz;
-    let a_max = motion.peak_accel(duration);
-    let run = match req.model {
-        ModelKind::Dda => {
-            let solver = SolverParams {
-                dt: req.dt,
-                duration,
-                integrator: req.integrator,
-                ..SolverParams::default()
-            };
-            two_block::run_dda(&scene, &motion, solver, req.record_every)?
-        }
-        ModelKind::MassSpring => two_block::run_exact(
-            req.alpha,
-            structure_hz,
-            roles.total_mass,
-            friction,
-            &motion,
-            duration,
-            req.dt * req.record_every as f64,
-        )?,
-    };
-    let d_scale = omega_ratio.map(|r| {
+    let d_scale = freq_ratio.map(|r| {
         let big_omega = 2.0 * std::f64::consts::PI * structure_hz * r;
         a_max / (big_omega * big_omega)
     });
+    let mut warnings = setup.warnings.clone();
+    if a_max <= 0.0 {
+        warnings.push(format!(
+            "the ground does not accelerate in the first {duration} s: the ratios to its \
+             peak (and to D) are undefined and left out"
+        ));
+    }
+    let exact = setup.model == ModelKind::MassSpring;
+    let ratio = |x: f64, by: f64| finite(x / by).filter(|_| by > 0.0);
     let summary = RunSummary {
-        scene: scene.name.clone(),
-        model: req.model.label().into(),
-        integrator: req.integrator.label(),
-        alpha: req.alpha,
-        friction: if req.fixed_base {
-            None
-        } else {
-            Some(req.friction)
-        },
-        fixed_base: req.fixed_base,
-        freq_ratio: omega_ratio,
-        excitation,
+        scene: setup.scene.name.clone(),
+        model: setup.model.label().into(),
+        integrator: (!exact).then(|| setup.integrator.label()),
+        alpha,
+        friction: reported_friction(setup, &mut warnings),
+        fixed_base: setup.fixed_base,
+        freq_ratio,
+        excitation: setup.excitation_label.clone(),
         amplitude_g: a_max / STANDARD_GRAVITY,
         duration_s: duration,
-        dt_s: req.dt,
-        us_max_over_d: d_scale.map(|d| run.peaks.slip_m / d),
-        ur_max_over_d: d_scale.map(|d| run.peaks.drift_m / d),
-        abase_over_aground: run.peaks.base_accel / a_max,
-        aroof_over_aground: run.peaks.roof_accel / a_max,
+        dt_s: (!exact).then_some(setup.dt),
+        us_max_over_d: d_scale.and_then(|d| ratio(run.peaks.slip_m, d)),
+        ur_max_over_d: d_scale.and_then(|d| ratio(run.peaks.drift_m, d)),
+        abase_over_aground: ratio(run.peaks.base_accel, a_max),
+        aroof_over_aground: ratio(run.peaks.roof_accel, a_max),
         us_max_m: run.peaks.slip_m,
         ur_max_m: run.peaks.drift_m,
         residual_slip_m: run.residual_slip_m,
@@ -294,34 +154,64 @@ pub fn run(req: &RunRequest) -> Result<RunOutcome> {
         input_work_j: run.input_work,
         friction_dissipated_j: run.friction_dissipated,
         wall_time_s: run.wall_time_s,
+        warnings,
     };
+    check_finite(&summary, duration)?;
     Ok(RunOutcome { summary, run })
 }
 
-/// Largest |ground displacement| over [0, duration] (sampled finely enough for a bound).
-fn max_abs_displacement(motion: &GroundMotion, duration: f64) -> f64 {
-    let n = 2000;
-    (0..=n)
-        .map(|k| motion.displacement(duration * k as f64 / n as f64).abs())
-        .fold(0.0, f64::max)
+/// The friction a summary reports: none for a fixed base, and none (with a warning) for a
+/// scene whose joint has `friction = inf`, which JSON cannot carry as a number.
+pub fn reported_friction(setup: &RunSetup, warnings: &mut Vec<String>) -> Option<f64> {
+    if setup.fixed_base {
+        return None;
+    }
+    if setup.friction.is_infinite() {
+        warnings.push(
+            "the sliding joint's friction is inf in the scene: it never slides, as a fixed \
+             base; `friction` is left out"
+                .into(),
+        );
+        return None;
+    }
+    Some(setup.friction)
 }
 
-/// Writes a run's histories and summary into `dir`.
-pub fn write_outputs(outcome: &RunOutcome, dir: &PathBuf) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let csv = dir.join("history.csv");
-    outcome.run.history.write_csv(&csv)?;
-    let json = dir.join("summary.json");
-    let text = serde_json::to_string_pretty(&outcome.summary)
-        .map_err(|e| Error::Scene(format!("cannot serialise the summary: {e}")))?;
-    std::fs::write(&json, text).map_err(|e| Error::io(&json, e))?;
-    let mut files = vec![csv, json];
-    if !outcome.run.history.is_empty() {
-        let png = dir.join("history.png");
-        history_figure(outcome).save_png(&png, 1400, 900)?;
-        files.push(png);
+/// `Some(x)` when x is finite.
+pub fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// The guarantee of every summary: its JSON carries no `null` (a NaN or inf would be
+/// written as one). A run that produced a non-finite number is a solver failure, reported
+/// as such rather than printed.
+pub fn check_finite<T: Serialize>(summary: &T, end_time: f64) -> Result<()> {
+    let value = serde_json::to_value(summary)
+        .map_err(|e| Error::invalid("summary", format!("cannot serialise: {e}")))?;
+    if let serde_json::Value::Object(map) = value
+        && let Some((key, _)) = map.iter().find(|(_, v)| v.is_null())
+    {
+        return Err(Error::Solver {
+            time: end_time,
+            reason: format!("the run produced a non-finite {key}"),
+        });
     }
-    Ok(files)
+    Ok(())
+}
+
+/// The history a two-block run written to a folder keeps.
+pub const OUTPUT_HISTORY: crate::setup::HistoryPlan =
+    crate::setup::HistoryPlan::EverySteps(defaults::TWO_BLOCK_HISTORY_EVERY);
+
+/// Writes a run's histories and summary into `dir`.
+pub fn write_outputs(outcome: &RunOutcome, dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut staged = Staged::new(dir)?;
+    outcome.run.history.write_csv(&staged.path("history.csv"))?;
+    staged.write_json("summary.json", &outcome.summary)?;
+    if !outcome.run.history.is_empty() {
+        history_figure(outcome).save_png(&staged.path("history.png"), 1400, 900)?;
+    }
+    staged.commit()
 }
 
 /// Time histories of a run: accelerations, slip and roof drift.

@@ -12,11 +12,12 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::run::{RunRequest, two_block_setup};
-use super::two_block::{self, TwoBlockRun};
+use super::simulate::{self, ModelRun};
 use crate::dda::{Dda, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, STANDARD_GRAVITY};
 use crate::model::Scene;
+use crate::post::output::Staged;
+use crate::setup::{ExcitationSpec, Frequency, RunSpec};
 use crate::{Error, Result};
 
 /// The outcome of one case.
@@ -67,13 +68,7 @@ impl StabilityCase {
 }
 
 /// A row for a finished two-block run.
-fn from_run(
-    case: &str,
-    run: &TwoBlockRun,
-    check: &str,
-    passed: bool,
-    detail: String,
-) -> StabilityRow {
+fn from_run(case: &str, run: &ModelRun, check: &str, passed: bool, detail: String) -> StabilityRow {
     let nan = [
         run.peaks.slip_m,
         run.peaks.drift_m,
@@ -149,48 +144,62 @@ fn stopped(case: &str, check: &str, e: &Error, expected: bool) -> StabilityRow {
 
 /// The defaults of the two-block cases: the paper's model (α = 0.5, ρ = 0.1, Ω = ω,
 /// 0.3 g) for 20 s, with no recorded history.
-fn base_req() -> RunRequest {
-    RunRequest {
+fn base_req() -> RunSpec {
+    RunSpec {
         duration: Some(20.0),
-        record_every: 0,
-        ..RunRequest::default()
+        ..RunSpec::default()
+    }
+}
+
+/// Harmonic input with this amplitude (g) and Ω/ω.
+fn harmonic(amplitude_g: f64, ratio: f64) -> ExcitationSpec {
+    ExcitationSpec::Harmonic {
+        amplitude_g: Some(amplitude_g),
+        frequency: Some(Frequency::Ratio(ratio)),
     }
 }
 
 /// A two-block DDA run with the scene adjusted by `adjust`; also returns the paper's
 /// displacement scale D = a_max/Ω² (1 m for records).
 fn two_block_run(
-    req: &RunRequest,
+    req: &RunSpec,
     params: SolverParams,
     adjust: impl FnOnce(&mut Scene),
-) -> Result<(TwoBlockRun, f64)> {
-    let mut setup = two_block_setup(req)?;
+) -> Result<(ModelRun, f64)> {
+    let mut setup = req.prepare()?;
     adjust(&mut setup.scene);
     let duration = setup.duration;
-    let d = match setup.freq_ratio {
-        Some(r) => {
-            let w = 2.0 * PI * r * setup.roles.structure_frequency_hz;
+    let d = match setup.two_block() {
+        Some((roles, _, Some(r))) => {
+            let w = 2.0 * PI * r * roles.structure_frequency_hz;
             setup.motion.peak_accel(duration) / (w * w)
         }
-        None => 1.0,
+        _ => 1.0,
     };
     let params = SolverParams {
         duration,
-        dt: req.dt,
+        dt: setup.dt,
         ..params
     };
-    let run = two_block::run_dda(&setup.scene, &setup.motion, params, 0)?;
+    let run = simulate::run_dda(&setup, &setup.scene, params)?;
     Ok((run, d))
 }
 
 /// The exact mass-spring solution of a request (structure frequency `structure_hz`
 /// instead of the scene's when given).
-fn exact(req: &RunRequest, structure_hz: Option<f64>) -> Result<TwoBlockRun> {
-    let setup = two_block_setup(req)?;
-    two_block::run_exact(
-        req.alpha,
-        structure_hz.unwrap_or(setup.roles.structure_frequency_hz),
-        setup.roles.total_mass,
+fn exact(req: &RunSpec, structure_hz: Option<f64>) -> Result<ModelRun> {
+    let setup = RunSpec {
+        dt: None,
+        ..req.clone()
+    }
+    .prepare()?;
+    let (roles, alpha, _) = setup
+        .two_block()
+        .ok_or_else(|| Error::invalid("--scene", "not a two-block scene"))?;
+    simulate::run_exact(
+        alpha,
+        structure_hz.unwrap_or(roles.structure_frequency_hz),
+        roles.total_mass,
         setup.friction,
         &setup.motion,
         setup.duration,
@@ -205,7 +214,7 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 /// Worst relative error of slip, drift and roof acceleration against the exact model.
-fn errors_against(run: &TwoBlockRun, reference: &TwoBlockRun) -> [f64; 3] {
+fn errors_against(run: &ModelRun, reference: &ModelRun) -> [f64; 3] {
     [
         rel(run.peaks.slip_m, reference.peaks.slip_m.max(1e-9)),
         rel(run.peaks.drift_m, reference.peaks.drift_m),
@@ -215,7 +224,7 @@ fn errors_against(run: &TwoBlockRun, reference: &TwoBlockRun) -> [f64; 3] {
 
 /// The base two-block case with `set` applied to its request: DDA against the exact
 /// model on slip, drift and roof acceleration, within `tol`.
-fn against_exact(case: &str, tol: f64, set: impl FnOnce(&mut RunRequest)) -> StabilityRow {
+fn against_exact(case: &str, tol: f64, set: impl FnOnce(&mut RunSpec)) -> StabilityRow {
     let mut req = base_req();
     set(&mut req);
     let check = format!(
@@ -280,8 +289,8 @@ fn penalty_case(case: &str, factor: f64) -> StabilityRow {
 
 fn friction_zero(case: &str) -> StabilityRow {
     let check = "nothing holds the raft: the structure stays unstrained, |u_r| < 1e-4 D";
-    let req = RunRequest {
-        friction: 0.0,
+    let req = RunSpec {
+        friction: Some(0.0),
         ..base_req()
     };
     match two_block_run(&req, SolverParams::default(), |_| {}) {
@@ -306,20 +315,20 @@ fn friction_zero(case: &str) -> StabilityRow {
 fn friction_ten(case: &str) -> StabilityRow {
     let check = "never slides, so equals the fixed base: roof acceleration and drift within \
                  1e-3, slip < 1e-5 m";
-    let req = RunRequest {
+    let req = RunSpec {
         duration: Some(5.0),
         ..base_req()
     };
     let sliding = two_block_run(
-        &RunRequest {
-            friction: 10.0,
+        &RunSpec {
+            friction: Some(10.0),
             ..req.clone()
         },
         SolverParams::default(),
         |_| {},
     );
     let fixed = two_block_run(
-        &RunRequest {
+        &RunSpec {
             fixed_base: true,
             ..req
         },
@@ -355,9 +364,9 @@ fn coarse_step(case: &str) -> StabilityRow {
     let check = "finishes (5 steps per excitation period) with |energy residual| < 0.5; the \
                  resolved structure's drift within 2 % of the exact model, the unresolved slip \
                  within a factor 2";
-    let req = RunRequest {
-        freq_ratio: 10.0,
-        dt: 0.02,
+    let req = RunSpec {
+        excitation: ExcitationSpec::ratio(10.0),
+        dt: Some(0.02),
         ..base_req()
     };
     let reference = match exact(&req, None) {
@@ -392,8 +401,8 @@ fn coarse_step(case: &str) -> StabilityRow {
 fn tiny_amplitude(case: &str) -> StabilityRow {
     let check = "never slides (0.001 g ≪ ρg = 0.1 g): no step with a sliding contact, \
                  |u_s| < 1e-3 D";
-    let req = RunRequest {
-        amplitude_g: 0.001,
+    let req = RunSpec {
+        excitation: harmonic(0.001, 1.0),
         ..base_req()
     };
     match two_block_run(&req, SolverParams::default(), |_| {}) {
@@ -418,8 +427,8 @@ fn tiny_amplitude(case: &str) -> StabilityRow {
 fn stiff_structure(case: &str) -> StabilityRow {
     let check = "finishes; the structure moves with its raft (|u_r| < 1e-3 |u_s|) and the \
                  slip is within 2 % of the exact model's with a 100 Hz structure";
-    let req = RunRequest {
-        dt: 0.01,
+    let req = RunSpec {
+        dt: Some(0.01),
         ..base_req()
     };
     let reference = match exact(&req, Some(100.0)) {
@@ -753,7 +762,7 @@ fn unsupported(case: &str) -> StabilityRow {
 /// 1000 s of the resonant paper model: the energy balance must not drift.
 fn long_run(case: &str) -> StabilityRow {
     let check = "no drift of the energy balance: |residual| < 1e-3 at 1000 s";
-    let req = RunRequest {
+    let req = RunSpec {
         duration: Some(1000.0),
         ..base_req()
     };
@@ -784,23 +793,23 @@ pub fn cases() -> Vec<StabilityCase> {
         case("penalty 1e6 × E", |n| penalty_case(n, 1e6)),
         case("friction 0", friction_zero),
         case("friction 1e-6", |n| {
-            against_exact(n, 0.05, |r| r.friction = 1e-6)
+            against_exact(n, 0.05, |r| r.friction = Some(1e-6))
         }),
         case("friction 10 (never slides)", friction_ten),
         case("α = 0.001", |n| {
-            against_exact(n, 0.02, |r| r.alpha = 0.001)
+            against_exact(n, 0.02, |r| r.alpha = Some(0.001))
         }),
         case("α = 0.999", |n| {
-            against_exact(n, 0.02, |r| r.alpha = 0.999)
+            against_exact(n, 0.02, |r| r.alpha = Some(0.999))
         }),
         case("Ω/ω = 10 with Δt = 0.02", coarse_step),
         case("amplitude 0.001 g", tiny_amplitude),
         case("amplitude 3 g", |n| {
-            against_exact(n, 0.02, |r| r.amplitude_g = 3.0)
+            against_exact(n, 0.02, |r| r.excitation = harmonic(3.0, 1.0))
         }),
         case("Pacoima Dam 1.2 g record", |n| {
             against_exact(n, 0.03, |r| {
-                r.record = Some("pacoima-dam-164".into());
+                r.excitation = ExcitationSpec::record("pacoima-dam-164");
                 r.duration = None;
             })
         }),
@@ -836,17 +845,10 @@ pub fn run_stability(include_slow: bool, tick: &dyn Fn(&StabilityRow)) -> Vec<St
 
 /// Writes `stability.csv` and `report.md` into `out`.
 pub fn write_stability(rows: &[StabilityRow], out: &Path) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let csv_path = out.join("stability.csv");
-    let csv_error = |e: csv::Error| Error::Scene(format!("{}: {e}", csv_path.display()));
-    let mut w = csv::Writer::from_path(&csv_path).map_err(csv_error)?;
-    for r in rows {
-        w.serialize(r).map_err(csv_error)?;
-    }
-    w.flush().map_err(|e| Error::io(&csv_path, e))?;
-    let md = out.join("report.md");
-    std::fs::write(&md, report_markdown(rows)).map_err(|e| Error::io(&md, e))?;
-    Ok(vec![csv_path, md])
+    let mut staged = Staged::new(out)?;
+    staged.write_csv("stability.csv", rows)?;
+    staged.write("report.md", report_markdown(rows))?;
+    staged.commit()
 }
 
 /// The report table: one row per case.

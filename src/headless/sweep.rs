@@ -2,10 +2,11 @@
 
 use rayon::prelude::*;
 
-use super::run::{RunRequest, run};
-use super::two_block::ModelKind;
+use super::run::run;
 use crate::dda::Integrator;
+use crate::limits::{MAX_LIST_VALUES, MAX_SWEEP_RUNS};
 use crate::post::sweep::SweepRow;
+use crate::setup::{ExcitationSpec, Frequency, ModelKind, RunSpec};
 use crate::{Error, Result};
 
 /// A grid of two-mass runs.
@@ -19,12 +20,14 @@ pub struct SweepRequest {
     pub freq_ratios: Vec<f64>,
     /// Harmonic amplitude, g.
     pub amplitude_g: f64,
-    /// Duration of every run, s.
-    pub duration: f64,
-    /// DDA time step, s.
-    pub dt: f64,
-    /// DDA integrator.
-    pub integrator: Integrator,
+    /// Duration of every run, s (default: the harmonic default of the run set-up).
+    pub duration: Option<f64>,
+    /// DDA time step, s (default: the run set-up's).
+    pub dt: Option<f64>,
+    /// DDA integrator (default: the run set-up's).
+    pub integrator: Option<Integrator>,
+    /// Run even beyond the step limit.
+    pub confirm_large: bool,
     /// Which models to run at every point.
     pub models: Vec<ModelKind>,
     /// Run only slice I of N (1-based): the grid's jobs I, I + N, I + 2N… so that a job
@@ -49,6 +52,13 @@ pub struct SweepFailure {
 
 /// Parses `0.1,0.5,0.9` into numbers, naming the flag in errors.
 pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>> {
+    let count = text.split(',').count();
+    if count > MAX_LIST_VALUES {
+        return Err(Error::invalid(
+            flag,
+            format!("{count} values; a list may have at most {MAX_LIST_VALUES}"),
+        ));
+    }
     let values: Result<Vec<f64>> = text
         .split(',')
         .map(|s| s.trim())
@@ -78,14 +88,22 @@ pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
             .map_err(|_| Error::invalid(flag, format!("'{s}' is not a number")))
     };
     let (lo, hi) = (num(parts[0])?, num(parts[1])?);
-    let n: usize = parts[2]
-        .trim()
-        .parse()
-        .map_err(|_| Error::invalid(flag, format!("'{}' is not a count", parts[2])))?;
+    let n: usize = parts[2].trim().parse().map_err(|_| {
+        Error::invalid(
+            flag,
+            format!("'{}' is not a count (a whole number >= 1)", parts[2]),
+        )
+    })?;
     if !(lo > 0.0 && hi >= lo && lo.is_finite() && hi.is_finite()) || n == 0 {
         return Err(Error::invalid(
             flag,
             "expected lo:hi:n with 0 < lo <= hi and n >= 1",
+        ));
+    }
+    if n > MAX_LIST_VALUES {
+        return Err(Error::invalid(
+            flag,
+            format!("{n} values; a list may have at most {MAX_LIST_VALUES}"),
         ));
     }
     if n == 1 {
@@ -110,13 +128,72 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
         i.trim().parse().map_err(|_| bad())?,
         n.trim().parse().map_err(|_| bad())?,
     );
-    if i == 0 || i > n {
+    if i == 0 || i > n || n > MAX_SWEEP_RUNS {
         return Err(bad());
     }
     Ok((i, n))
 }
 
 impl SweepRequest {
+    /// The run of one grid point, as every front end sets it up.
+    pub fn spec(&self, model: ModelKind, alpha: f64, friction: f64, freq_ratio: f64) -> RunSpec {
+        let dda = model == ModelKind::Dda;
+        RunSpec {
+            model,
+            excitation: ExcitationSpec::Harmonic {
+                amplitude_g: Some(self.amplitude_g),
+                frequency: Some(Frequency::Ratio(freq_ratio)),
+            },
+            alpha: Some(alpha),
+            friction: Some(friction),
+            duration: self.duration,
+            // The exact model has no time step or integrator.
+            dt: if dda { self.dt } else { None },
+            integrator: if dda { self.integrator } else { None },
+            confirm_large: self.confirm_large,
+            ..RunSpec::default()
+        }
+    }
+
+    /// Checks the grid before any run starts: its size, and every value of every list
+    /// through the run set-up (each α with the first ρ and Ω/ω, and so on, for each
+    /// model), so that a bad value is reported with its flag at once, not as a failure of
+    /// a run hours later.
+    pub fn validate(&self) -> Result<()> {
+        let runs = self.models.len() as f64
+            * self.alphas.len() as f64
+            * self.frictions.len() as f64
+            * self.freq_ratios.len() as f64;
+        if runs > MAX_SWEEP_RUNS as f64 {
+            return Err(Error::invalid(
+                "--alpha/--friction/--freq-ratios",
+                format!("the grid has {runs:e} runs; a sweep may have at most {MAX_SWEEP_RUNS}"),
+            ));
+        }
+        let (Some(&a0), Some(&f0), Some(&r0)) = (
+            self.alphas.first(),
+            self.frictions.first(),
+            self.freq_ratios.first(),
+        ) else {
+            return Err(Error::invalid(
+                "--alpha/--friction/--freq-ratios",
+                "a list is empty",
+            ));
+        };
+        for &model in &self.models {
+            let points = self
+                .alphas
+                .iter()
+                .map(|&a| (a, f0, r0))
+                .chain(self.frictions.iter().map(|&f| (a0, f, r0)))
+                .chain(self.freq_ratios.iter().map(|&r| (a0, f0, r)));
+            for (a, f, r) in points {
+                self.spec(model, a, f, r).prepare()?;
+            }
+        }
+        Ok(())
+    }
+
     /// Every (model, α, ρ, Ω/ω) of the grid (or of this request's shard), mass-spring
     /// first (it is quick).
     pub fn jobs(&self) -> Vec<(ModelKind, f64, f64, f64)> {
@@ -152,41 +229,43 @@ pub fn run_sweep(
         .jobs()
         .par_iter()
         .map(|&(model, alpha, friction, freq_ratio)| {
-            let request = RunRequest {
+            let request = req.spec(model, alpha, friction, freq_ratio);
+            let out = run(&request);
+            tick();
+            let failure = |message: String| SweepFailure {
+                model,
                 alpha,
                 friction,
                 freq_ratio,
-                amplitude_g: req.amplitude_g,
-                duration: Some(req.duration),
-                dt: req.dt,
-                integrator: req.integrator,
-                model,
-                record_every: 0,
-                ..RunRequest::default()
+                message,
             };
-            let out = run(&request);
-            tick();
-            match out {
-                Ok(o) => Ok(SweepRow {
-                    model: model.label().to_string(),
-                    alpha,
-                    friction,
-                    freq_ratio,
-                    us_max_over_d: o.summary.us_max_over_d.unwrap_or(f64::NAN),
-                    ur_max_over_d: o.summary.ur_max_over_d.unwrap_or(f64::NAN),
-                    abase_over_aground: o.summary.abase_over_aground,
-                    aroof_over_aground: o.summary.aroof_over_aground,
-                    steps: o.summary.steps,
-                    wall_time_s: o.summary.wall_time_s,
-                    energy_residual_rel: o.summary.energy_residual_rel,
-                }),
-                Err(e) => Err(SweepFailure {
-                    model,
-                    alpha,
-                    friction,
-                    freq_ratio,
-                    message: e.to_string(),
-                }),
+            let o = out.map_err(|e| failure(e.to_string()))?;
+            let s = &o.summary;
+            match (
+                s.us_max_over_d,
+                s.ur_max_over_d,
+                s.abase_over_aground,
+                s.aroof_over_aground,
+            ) {
+                (Some(us), Some(ur), Some(ab), Some(ar)) if s.energy_residual_rel.is_finite() => {
+                    Ok(SweepRow {
+                        model: model.label().to_string(),
+                        alpha,
+                        friction,
+                        freq_ratio,
+                        us_max_over_d: us,
+                        ur_max_over_d: ur,
+                        abase_over_aground: ab,
+                        aroof_over_aground: ar,
+                        steps: s.steps,
+                        wall_time_s: s.wall_time_s,
+                        energy_residual_rel: s.energy_residual_rel,
+                    })
+                }
+                _ => Err(failure(format!(
+                    "a metric is undefined for this run ({})",
+                    s.warnings.join("; ")
+                ))),
             }
         })
         .collect();
@@ -227,9 +306,10 @@ mod tests {
             frictions: vec![0.05, 0.1, 0.25],
             freq_ratios: vec![0.5, 1.0, 2.0],
             amplitude_g: 0.3,
-            duration: 1.0,
-            dt: 1e-3,
-            integrator: Integrator::default(),
+            duration: Some(1.0),
+            dt: None,
+            integrator: None,
+            confirm_large: false,
             models: vec![ModelKind::MassSpring, ModelKind::Dda],
             shard: None,
         };

@@ -148,6 +148,55 @@ fn segments_intersect(p1: Point, p2: Point, q1: Point, q2: Point) -> bool {
     ((d1 > 0.0) != (d2 > 0.0)) && ((d3 > 0.0) != (d4 > 0.0))
 }
 
+/// Distance from `p` to the segment `a`–`b`.
+pub fn segment_distance(p: Point, a: Point, b: Point) -> f64 {
+    let ab = sub(b, a);
+    let len2 = dot(ab, ab);
+    let s = if len2 > 0.0 {
+        (dot(sub(p, a), ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q = [a[0] + s * ab[0], a[1] + s * ab[1]];
+    (p[0] - q[0]).hypot(p[1] - q[1])
+}
+
+/// Distance from `p` to the polygon's boundary.
+pub fn boundary_distance(vertices: &[Point], p: Point) -> f64 {
+    let n = vertices.len();
+    (0..n)
+        .map(|k| segment_distance(p, vertices[k], vertices[(k + 1) % n]))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// How far `p` lies outside the polygon (0 inside or on the boundary).
+pub fn distance_outside(vertices: &[Point], p: Point) -> f64 {
+    if contains(vertices, p) {
+        0.0
+    } else {
+        boundary_distance(vertices, p)
+    }
+}
+
+/// Whether two segments cross each other at a single interior point, each end of either
+/// clearly (by more than `tol`) on its own side of the other: touching, overlapping
+/// collinear edges and shared vertices are not crossings.
+pub fn segments_cross(p1: Point, p2: Point, q1: Point, q2: Point, tol: f64) -> bool {
+    let side = |a: Point, b: Point, c: Point| {
+        let ab = sub(b, a);
+        let len = dot(ab, ab).sqrt();
+        if len == 0.0 {
+            0.0
+        } else {
+            cross(ab, sub(c, a)) / len
+        }
+    };
+    let (d1, d2) = (side(q1, q2, p1), side(q1, q2, p2));
+    let (d3, d4) = (side(p1, p2, q1), side(p1, p2, q2));
+    ((d1 > tol && d2 < -tol) || (d1 < -tol && d2 > tol))
+        && ((d3 > tol && d4 < -tol) || (d3 < -tol && d4 > tol))
+}
+
 /// Whether point `p` lies inside the polygon (crossing-number test).
 pub fn contains(vertices: &[Point], p: Point) -> bool {
     let n = vertices.len();

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::limits::{DENSITY_RANGE, YOUNGS_MODULUS_RANGE};
 use crate::{Error, Result};
 
 /// Two-dimensional idealisation of the third direction.
@@ -34,18 +35,10 @@ impl Material {
     /// Checks the ranges; `owner` names the block or element in the message.
     pub fn validate(&self, owner: &str) -> Result<()> {
         let field = |f: &str| format!("{owner}.{f}");
-        if !(self.density.is_finite() && self.density > 0.0) {
-            return Err(Error::invalid(
-                field("density"),
-                format!("must be > 0, got {}", self.density),
-            ));
-        }
-        if !(self.youngs_modulus.is_finite() && self.youngs_modulus > 0.0) {
-            return Err(Error::invalid(
-                field("youngs_modulus"),
-                format!("must be > 0, got {}", self.youngs_modulus),
-            ));
-        }
+        let (lo, hi) = DENSITY_RANGE;
+        crate::error::require_range(&field("density"), self.density, lo, hi, "kg/m³")?;
+        let (lo, hi) = YOUNGS_MODULUS_RANGE;
+        crate::error::require_range(&field("youngs_modulus"), self.youngs_modulus, lo, hi, "Pa")?;
         if !(self.poisson_ratio.is_finite() && (0.0..0.5).contains(&self.poisson_ratio)) {
             return Err(Error::invalid(
                 field("poisson_ratio"),

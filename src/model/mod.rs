@@ -5,5 +5,6 @@ pub mod geometry;
 pub mod material;
 pub mod presets;
 pub mod scene;
+pub mod validate;
 
 pub use scene::Scene;

@@ -5,14 +5,14 @@
 //! of terms (no bolts → no bolt code runs; blocks joined only by connection elements get
 //! no contact search, because contact search runs only on the declared contact pairs).
 
-use std::collections::HashSet;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::geometry::{self, Point};
+use super::geometry::Point;
 use super::material::Material;
 use crate::ground_motion::STANDARD_GRAVITY;
+use crate::limits::MAX_SCENE_FILE_BYTES;
 use crate::{Error, Result};
 
 /// A complete scene.
@@ -81,6 +81,7 @@ pub struct BlockDef {
     /// Unique name, used by contacts, joints and reports.
     pub name: String,
     /// Polygon vertices, counter-clockwise, m.
+    #[serde(deserialize_with = "strict::points")]
     pub vertices: Vec<Point>,
     /// Its material.
     pub material: Material,
@@ -176,6 +177,7 @@ pub struct BoltDef {
     /// The two block names.
     pub blocks: [String; 2],
     /// End points (in the respective blocks), m.
+    #[serde(deserialize_with = "strict::point_pair")]
     pub points: [Point; 2],
     /// Spring constant, N/m per unit thickness.
     pub stiffness: f64,
@@ -191,6 +193,7 @@ pub struct ConnectionNode {
     /// The block that carries this node.
     pub block: String,
     /// The node's position, m.
+    #[serde(deserialize_with = "strict::point")]
     pub point: Point,
 }
 
@@ -224,6 +227,7 @@ pub struct FixedPointDef {
     /// Block name.
     pub block: String,
     /// The point, m.
+    #[serde(deserialize_with = "strict::point")]
     pub point: Point,
     /// Pin or roller.
     #[serde(default)]
@@ -240,8 +244,10 @@ pub struct PointLoadDef {
     /// Block name.
     pub block: String,
     /// Point of application, m.
+    #[serde(deserialize_with = "strict::point")]
     pub point: Point,
     /// Force (Fx, Fy), N per unit thickness.
+    #[serde(deserialize_with = "strict::point")]
     pub force: Point,
 }
 
@@ -273,6 +279,47 @@ fn one() -> f64 {
     1.0
 }
 
+/// Points read strictly: exactly two coordinates (a third would otherwise be dropped
+/// without a word: slidebase is two-dimensional).
+mod strict {
+    use serde::de::Error as _;
+    use serde::{Deserialize, Deserializer};
+
+    use super::Point;
+
+    fn exactly_two<E: serde::de::Error>(v: Vec<f64>) -> Result<Point, E> {
+        match v.as_slice() {
+            [x, y] => Ok([*x, *y]),
+            _ => Err(E::custom(format!(
+                "a point is [x, y] (two coordinates, m), got {} numbers",
+                v.len()
+            ))),
+        }
+    }
+
+    pub fn point<'de, D: Deserializer<'de>>(d: D) -> Result<Point, D::Error> {
+        exactly_two(Vec::<f64>::deserialize(d)?)
+    }
+
+    pub fn points<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Point>, D::Error> {
+        Vec::<Vec<f64>>::deserialize(d)?
+            .into_iter()
+            .map(exactly_two)
+            .collect()
+    }
+
+    pub fn point_pair<'de, D: Deserializer<'de>>(d: D) -> Result<[Point; 2], D::Error> {
+        let v = points(d)?;
+        match v.as_slice() {
+            [a, b] => Ok([*a, *b]),
+            _ => Err(D::Error::custom(format!(
+                "a bolt has two end points, got {}",
+                v.len()
+            ))),
+        }
+    }
+}
+
 /// Names the parts of a two-mass scene (paper Fig. 2) so that α, ρ and Ω/ω can be set.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -301,13 +348,13 @@ impl Scene {
                 .unwrap_or(0);
             Error::parse(label, line, e.message().to_string())
         })?;
-        scene.validate()?;
+        super::validate::check(&scene).map_err(|i| i.into_error(Some((label, text))))?;
         Ok(scene)
     }
 
-    /// Loads a scene from a TOML file.
+    /// Loads a scene from a TOML file (at most [`MAX_SCENE_FILE_BYTES`] of a regular file).
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::limits::read_text(path, MAX_SCENE_FILE_BYTES, "scene")?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
@@ -331,158 +378,5 @@ impl Scene {
                         .join(", ")
                 ))
             })
-    }
-
-    /// Checks names, polygons, materials and parameter ranges.
-    pub fn validate(&self) -> Result<()> {
-        if !(self.gravity.is_finite() && self.gravity >= 0.0) {
-            return Err(Error::invalid(
-                "gravity",
-                format!("must be >= 0, got {}", self.gravity),
-            ));
-        }
-        let mut names = HashSet::new();
-        for b in &self.blocks {
-            if !names.insert(b.name.as_str()) {
-                return Err(Error::Scene(format!("two blocks are named '{}'", b.name)));
-            }
-            geometry::moments(&b.vertices, &b.name)?;
-            geometry::check_simple(&b.vertices, &b.name)?;
-            b.material.validate(&format!("block '{}'", b.name))?;
-        }
-        let g = self.block_index(&self.ground.block)?;
-        if self.ground.kind == GroundKind::LargeMass {
-            crate::error::require_positive("ground.mass_ratio", self.ground.mass_ratio)?;
-        }
-        if self.blocks.len() < 2 {
-            return Err(Error::Scene(
-                "a scene needs the ground and at least one block".into(),
-            ));
-        }
-        for c in &self.contacts {
-            let (a, b) = (
-                self.block_index(&c.blocks[0])?,
-                self.block_index(&c.blocks[1])?,
-            );
-            if a == b {
-                return Err(Error::Scene(format!(
-                    "contact '{}' joins block '{}' to itself",
-                    c.name, c.blocks[0]
-                )));
-            }
-            if c.friction.is_nan() || c.friction < 0.0 {
-                return Err(Error::invalid(
-                    format!("contact '{}' friction", c.name),
-                    format!("must be >= 0, got {}", c.friction),
-                ));
-            }
-            for (field, v) in [
-                ("normal_penalty", c.normal_penalty),
-                ("shear_penalty", c.shear_penalty),
-            ] {
-                if let Some(v) = v {
-                    crate::error::require_positive(&format!("contact '{}' {field}", c.name), v)?;
-                }
-            }
-        }
-        for bolt in &self.bolts {
-            let (a, b) = (
-                self.block_index(&bolt.blocks[0])?,
-                self.block_index(&bolt.blocks[1])?,
-            );
-            if a == b {
-                return Err(Error::Scene(format!(
-                    "bolt '{}' joins a block to itself",
-                    bolt.name
-                )));
-            }
-            crate::error::require_positive(
-                &format!("bolt '{}' stiffness", bolt.name),
-                bolt.stiffness,
-            )?;
-        }
-        for (k, c) in self.connections.iter().enumerate() {
-            let owners: Result<Vec<usize>> =
-                c.nodes.iter().map(|n| self.block_index(&n.block)).collect();
-            let owners = owners?;
-            if owners[0] == owners[1] && owners[1] == owners[2] {
-                return Err(Error::Scene(format!(
-                    "connection {k}: all three nodes are in block '{}'; a connection joins 2 or 3 blocks",
-                    c.nodes[0].block
-                )));
-            }
-            let pts: Vec<Point> = c.nodes.iter().map(|n| n.point).collect();
-            geometry::moments(&pts, &format!("connection {k}"))?;
-            c.material.validate(&format!("connection {k}"))?;
-        }
-        for f in &self.fixed_points {
-            self.block_index(&f.block)?;
-            if let Some(p) = f.penalty {
-                crate::error::require_positive("fixed_point penalty", p)?;
-            }
-        }
-        for l in &self.point_loads {
-            let i = self.block_index(&l.block)?;
-            if i == g && self.ground.kind == GroundKind::Prescribed {
-                return Err(Error::Scene(
-                    "a point load on a prescribed ground has no effect".into(),
-                ));
-            }
-            if !(l.force[0].is_finite() && l.force[1].is_finite()) {
-                return Err(Error::invalid("point_load force", "must be finite"));
-            }
-        }
-        match &self.excitation {
-            ExcitationDef::None => {}
-            ExcitationDef::Harmonic {
-                amplitude_g,
-                frequency_hz,
-            } => {
-                crate::error::require_positive("excitation.amplitude_g", *amplitude_g)?;
-                crate::error::require_positive("excitation.frequency_hz", *frequency_hz)?;
-            }
-            ExcitationDef::Record { scale, .. } => {
-                crate::error::require_positive("excitation.scale", *scale)?;
-            }
-        }
-        if let Some(r) = &self.structure {
-            self.block_index(&r.base)?;
-            if r.floors.is_empty() {
-                return Err(Error::Scene(
-                    "structure.floors must name at least one floor".into(),
-                ));
-            }
-            for f in &r.floors {
-                self.block_index(f)?;
-            }
-            if !self.contacts.iter().any(|c| c.name == r.joint) {
-                return Err(Error::Scene(format!(
-                    "structure.joint: no contact named '{}'",
-                    r.joint
-                )));
-            }
-        }
-        if let Some(r) = &self.two_block {
-            self.block_index(&r.raft)?;
-            self.block_index(&r.roof)?;
-            if !self.bolts.iter().any(|b| b.name == r.spring) {
-                return Err(Error::Scene(format!(
-                    "two_block.spring: no bolt named '{}'",
-                    r.spring
-                )));
-            }
-            if !self.contacts.iter().any(|c| c.name == r.joint) {
-                return Err(Error::Scene(format!(
-                    "two_block.joint: no contact named '{}'",
-                    r.joint
-                )));
-            }
-            crate::error::require_positive(
-                "two_block.structure_frequency_hz",
-                r.structure_frequency_hz,
-            )?;
-            crate::error::require_positive("two_block.total_mass", r.total_mass)?;
-        }
-        Ok(())
     }
 }

@@ -223,7 +223,7 @@ impl Figure {
     pub fn save_png(&self, path: &Path, width: u32, height: u32) -> Result<()> {
         register_font()?;
         let plot_err = |e: &dyn std::fmt::Display| {
-            Error::Scene(format!("{}: cannot draw the figure: {e}", path.display()))
+            Error::output(path, format!("cannot draw or write the figure: {e}"))
         };
         if let Some(parent) = path.parent()
             && !parent.as_os_str().is_empty()

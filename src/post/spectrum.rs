@@ -65,10 +65,6 @@ pub fn resample_uniform(t: &[f64], y: &[f64], dt: f64) -> Result<Vec<f64>> {
     Ok(out)
 }
 
-/// The sample interval spectra of solver histories are computed at (`run --json`'s
-/// `base_accel_peak_freq_hz` and the visualizer's spectra use the same grid).
-pub const SPECTRUM_DT: f64 = 0.005;
-
 /// The Fourier amplitude spectrum of a history sampled at increasing times `t` (not
 /// necessarily evenly), resampled onto a uniform grid of step `dt` first.
 pub fn uniform_spectrum(t: &[f64], y: &[f64], dt: f64) -> Result<Spectrum> {
@@ -100,6 +96,80 @@ pub fn interpolate(t: &[f64], y: &[f64], at: &[f64]) -> Vec<f64> {
             y[k - 1] + w * (y[k] - y[k - 1])
         })
         .collect()
+}
+
+/// [`resample_uniform`] done on the fly: points are pushed as a run produces them and
+/// only the uniform samples are kept, so a spectrum of a long run needs no stored history.
+/// The samples are those `resample_uniform` gives for the same points. Beyond
+/// `max_samples` every other sample is dropped and the spacing doubled, so memory stays
+/// bounded however long the run (the spectrum then ends at a lower Nyquist frequency).
+#[derive(Debug, Clone)]
+pub struct UniformSeries {
+    dt: f64,
+    max_samples: usize,
+    t0: f64,
+    last: Option<(f64, f64)>,
+    samples: Vec<f64>,
+}
+
+impl UniformSeries {
+    /// An empty series with spacing `dt` (> 0) and at most `max_samples` (≥ 2) samples.
+    pub fn new(dt: f64, max_samples: usize) -> Self {
+        Self {
+            dt,
+            max_samples: max_samples.max(2),
+            t0: 0.0,
+            last: None,
+            samples: Vec::new(),
+        }
+    }
+
+    /// Adds the value `y` at time `t` (times must increase).
+    pub fn push(&mut self, t: f64, y: f64) {
+        let Some((tp, yp)) = self.last else {
+            self.t0 = t;
+            self.samples.push(y);
+            self.last = Some((t, y));
+            return;
+        };
+        let span = t - tp;
+        loop {
+            let tk = self.t0 + self.samples.len() as f64 * self.dt;
+            if tk > t {
+                break;
+            }
+            let w = if span > 0.0 {
+                ((tk - tp) / span).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            self.samples.push(yp * (1.0 - w) + y * w);
+            if self.samples.len() >= self.max_samples {
+                self.decimate();
+            }
+        }
+        self.last = Some((t, y));
+    }
+
+    fn decimate(&mut self) {
+        let kept: Vec<f64> = self.samples.iter().step_by(2).copied().collect();
+        self.samples = kept;
+        self.dt *= 2.0;
+    }
+
+    /// The uniform samples from the first pushed time, and their spacing.
+    pub fn finish(mut self) -> (Vec<f64>, f64) {
+        if let Some((t_last, y_last)) = self.last {
+            // The same count as `resample_uniform`: the last grid time not after the last
+            // point (rounding can put one sample on either side).
+            let n = ((t_last - self.t0) / self.dt).floor() as usize + 1;
+            self.samples.truncate(n);
+            while self.samples.len() < n {
+                self.samples.push(y_last);
+            }
+        }
+        (self.samples, self.dt)
+    }
 }
 
 impl Spectrum {
@@ -169,6 +239,34 @@ mod tests {
         let c = fourier_amplitude(&[1.0; 64], 0.1).unwrap();
         assert_eq!(c.peak(0.0, 100.0).unwrap().0, 0.0);
         assert!(fourier_amplitude(&[1.0, f64::NAN], 0.1).is_err());
+    }
+
+    /// The on-the-fly series equals the resampling of the stored points.
+    #[test]
+    fn uniform_series_equals_resample_uniform() {
+        let t: Vec<f64> = (0..500)
+            .map(|k| 0.001 + 0.0013 * k as f64 + 1e-4 * (k % 3) as f64)
+            .collect();
+        let y: Vec<f64> = t.iter().map(|t| (7.0 * t).sin()).collect();
+        let offline = resample_uniform(&t, &y, 0.005).unwrap();
+        let mut online = UniformSeries::new(0.005, 1 << 20);
+        for (&ti, &yi) in t.iter().zip(&y) {
+            online.push(ti, yi);
+        }
+        let (samples, dt) = online.finish();
+        assert_eq!(dt, 0.005);
+        assert_eq!(samples, offline);
+        // Bounded: 1000 points into at most 64 samples.
+        let mut small = UniformSeries::new(0.001, 64);
+        for k in 0..1000 {
+            small.push(k as f64 * 0.001, 1.0);
+        }
+        let (samples, dt) = small.finish();
+        assert!(
+            samples.len() <= 64 && dt > 0.001,
+            "{} samples at {dt}",
+            samples.len()
+        );
     }
 
     #[test]

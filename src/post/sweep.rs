@@ -3,10 +3,11 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::output::Staged;
 use super::plot::{Figure, Series};
 use crate::{Error, Result};
 
@@ -46,6 +47,70 @@ pub const METRICS: [&str; 4] = [
 ];
 
 impl SweepRow {
+    /// The columns of `sweep.csv`, in order.
+    pub const COLUMNS: [&'static str; 11] = [
+        "model",
+        "alpha",
+        "friction",
+        "freq_ratio",
+        "us_max_over_d",
+        "ur_max_over_d",
+        "abase_over_aground",
+        "aroof_over_aground",
+        "steps",
+        "wall_time_s",
+        "energy_residual_rel",
+    ];
+
+    /// The ranges a row must be in to be used: known model, α ∈ (0, 1), finite ρ ≥ 0,
+    /// finite Ω/ω > 0, finite metrics ≥ 0, at least one step, finite wall time and energy
+    /// residual.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        if !matches!(self.model.as_str(), "mass-spring" | "dda") {
+            return Err(format!(
+                "unknown model '{}' (known: mass-spring, dda)",
+                self.model
+            ));
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) {
+            return Err(format!("alpha {} is outside (0, 1)", self.alpha));
+        }
+        if !(self.friction.is_finite() && self.friction >= 0.0) {
+            return Err(format!(
+                "friction {} must be finite and >= 0",
+                self.friction
+            ));
+        }
+        if !(self.freq_ratio.is_finite() && self.freq_ratio > 0.0) {
+            return Err(format!(
+                "freq_ratio {} must be finite and > 0",
+                self.freq_ratio
+            ));
+        }
+        for (k, name) in METRICS.iter().enumerate() {
+            let v = self.metric(k);
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} {v} must be finite and >= 0"));
+            }
+        }
+        if self.steps == 0 {
+            return Err("steps must be at least 1".into());
+        }
+        if !(self.wall_time_s.is_finite() && self.wall_time_s >= 0.0) {
+            return Err(format!(
+                "wall_time_s {} must be finite and >= 0",
+                self.wall_time_s
+            ));
+        }
+        if !self.energy_residual_rel.is_finite() {
+            return Err(format!(
+                "energy_residual_rel {} must be finite",
+                self.energy_residual_rel
+            ));
+        }
+        Ok(())
+    }
+
     /// A metric by its name in [`METRICS`].
     pub fn metric(&self, k: usize) -> f64 {
         match k {
@@ -59,25 +124,55 @@ impl SweepRow {
 
 /// Writes the rows as CSV with a header.
 pub fn write_sweep_csv(path: &Path, rows: &[SweepRow]) -> Result<()> {
-    let mut w = csv::Writer::from_path(path)
-        .map_err(|e| Error::Scene(format!("{}: {e}", path.display())))?;
+    let csv_error = |e: csv::Error| Error::output(path, format!("cannot write the table: {e}"));
+    let mut w = csv::Writer::from_path(path).map_err(csv_error)?;
+    if rows.is_empty() {
+        // An empty table still has its header, so that `merge` can read it.
+        w.write_record(SweepRow::COLUMNS).map_err(csv_error)?;
+    }
     for r in rows {
-        w.serialize(r)
-            .map_err(|e| Error::Scene(format!("{}: {e}", path.display())))?;
+        w.serialize(r).map_err(csv_error)?;
     }
     w.flush().map_err(|e| Error::io(path, e))
 }
 
-/// Reads a sweep CSV; errors name the file and line.
+/// Reads a sweep CSV and checks every row (known model, α in (0, 1), finite ρ ≥ 0 and
+/// Ω/ω > 0, finite non-negative metrics); errors name the file and line. A table with
+/// only its header (an empty shard) has no rows; a file without the header is refused.
 pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut r = csv::Reader::from_reader(file);
+    let text = crate::limits::read_text(path, crate::limits::MAX_TABLE_FILE_BYTES, "sweep table")?;
+    let label = path.display().to_string();
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let mut r = csv::Reader::from_reader(text.as_bytes());
+    let header: Vec<String> = r
+        .headers()
+        .map_err(|e| Error::parse(&label, 1, e.to_string()))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    if header != SweepRow::COLUMNS {
+        return Err(Error::parse(
+            &label,
+            1,
+            format!(
+                "not a sweep table: the header must be '{}', got '{}'",
+                SweepRow::COLUMNS.join(","),
+                header.join(",")
+            ),
+        ));
+    }
+    let headers = csv::StringRecord::from(header);
     let mut rows = Vec::new();
-    for rec in r.deserialize::<SweepRow>() {
-        let row = rec.map_err(|e| {
+    for rec in r.records() {
+        let rec = rec.map_err(|e| {
             let line = e.position().map_or(0, |p| p.line() as usize);
-            Error::parse(path.display().to_string(), line, e.to_string())
+            Error::parse(&label, line, e.to_string())
         })?;
+        let line = rec.position().map_or(0, |p| p.line() as usize);
+        let row: SweepRow = rec
+            .deserialize(Some(&headers))
+            .map_err(|e| Error::parse(&label, line, e.to_string()))?;
+        row.check().map_err(|m| Error::parse(&label, line, m))?;
         rows.push(row);
     }
     Ok(rows)
@@ -189,6 +284,10 @@ impl fmt::Display for ErrorTable {
         )?;
         writeln!(f, "|---|---:|---:|---:|---:|---|")?;
         for m in &self.metrics {
+            if m.count == 0 {
+                writeln!(f, "| {} | 0 | – | – | – | – |", m.name)?;
+                continue;
+            }
             writeln!(
                 f,
                 "| {} | {} | {:.3} % | {:.3} % | {:.3} % | ({}, {}, {:.3}) |",
@@ -221,14 +320,13 @@ impl fmt::Display for ErrorTable {
 /// Writes figures laid out like the paper's Figs 4–9: per α, a displacement figure
 /// ((a) |u_s|/D, (b) |u_r|/D) and an acceleration figure ((a) |a_base|/a_g, (b) |a_roof|/a_g)
 /// against Ω/ω on log axes; exact model as lines, DDA as markers, one colour per ρ.
-pub fn plot_paper_figures(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathBuf>> {
+pub fn plot_paper_figures(rows: &[SweepRow], out: &mut Staged) -> Result<()> {
     let mut alphas: Vec<f64> = rows.iter().map(|r| r.alpha).collect();
     alphas.sort_by(f64::total_cmp);
     alphas.dedup();
     let mut frictions: Vec<f64> = rows.iter().map(|r| r.friction).collect();
     frictions.sort_by(f64::total_cmp);
     frictions.dedup();
-    let mut files = Vec::new();
     for &alpha in &alphas {
         // The paper's figure numbers for its three mass ratios; other α get their own names.
         let paper_fig = [(0.1, 4), (0.5, 6), (0.9, 8)]
@@ -288,12 +386,11 @@ pub fn plot_paper_figures(rows: &[SweepRow], out_dir: &Path) -> Result<Vec<PathB
                     }
                 }
             }
-            let path = out_dir.join(format!("{prefix}alpha{alpha}_{kind}.png"));
+            let path = out.path(&format!("{prefix}alpha{alpha}_{kind}.png"));
             fig.save_png(&path, 1400, 600)?;
-            files.push(path);
         }
     }
-    Ok(files)
+    Ok(())
 }
 
 #[cfg(test)]

@@ -287,17 +287,19 @@ impl Extractor {
 
     /// The scalar responses now.
     pub fn probes(&self, dda: &Dda, motion: Option<&GroundMotion>) -> Probes {
-        let t = dda.time();
-        let base = &dda.blocks()[self.base];
-        let roof = &dda.blocks()[self.roof];
-        let ground_disp = motion.map_or(0.0, |m| m.displacement(t));
+        // Slip, drift and the accelerations as every front end defines them.
+        let r = crate::setup::Probe {
+            base: self.base,
+            roof: self.roof,
+        }
+        .measure(dda, motion);
         Probes {
-            ground_accel: motion.map_or(0.0, |m| m.accel(t)),
-            ground_disp,
-            base_accel: base.accel[0],
-            roof_accel: roof.accel[0],
-            slip: base.centroid_displacement()[0] - ground_disp,
-            drift: roof.centroid_displacement()[0] - base.centroid_displacement()[0],
+            ground_accel: r.ground_accel,
+            ground_disp: r.ground_disp,
+            base_accel: r.base_accel,
+            roof_accel: r.roof_accel,
+            slip: r.slip,
+            drift: r.drift,
             joint_force: 0.0,
             energy: EnergyTerms::default(),
         }

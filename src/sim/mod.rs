@@ -14,13 +14,12 @@ use std::time::{Duration, Instant};
 
 pub use frame::{Attached, BlockFrame, ContactFrame, Extractor, ModelFrame, Probes, Samples};
 
+use crate::Result;
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
-use crate::dda::{Dda, Integrator, SolverParams};
-use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
+use crate::dda::{Dda, Integrator};
+use crate::ground_motion::GroundMotion;
 use crate::model::Scene;
-use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground, resolve_scene};
-use crate::model::scene::ExcitationDef;
-use crate::{Error, Result};
+use crate::setup::{ExcitationSpec, Frequency, RunSetup, RunSpec};
 
 /// The ground motion of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,7 +59,8 @@ pub struct SimConfig {
     pub compare_friction: Vec<f64>,
     /// Scale the ground motion to this peak ground acceleration, g (None: as recorded).
     pub pga_g: Option<f64>,
-    /// Duration, s (None: the record's length, or 20 s for harmonic input).
+    /// Duration, s (None: the record's length, or the default of harmonic input,
+    /// [`crate::setup::defaults::HARMONIC_DURATION_S`]).
     pub duration: Option<f64>,
     /// Simulated time between published frames, s.
     pub frame_dt: f64,
@@ -74,7 +74,7 @@ impl Default for SimConfig {
             alpha: None,
             excitation: Excitation::Scene,
             integrator: Integrator::default(),
-            dt: 1e-3,
+            dt: crate::setup::defaults::DT,
             compare_fixed: true,
             compare_friction: Vec::new(),
             pga_g: None,
@@ -103,6 +103,9 @@ pub struct PreparedRun {
     /// For two-block scenes: the exact mass-spring solution (time, slip, drift, base accel,
     /// roof accel), for overlaying on the DDA curves.
     pub exact: Option<ExactOverlay>,
+    /// What the user should know about the run (e.g. a time step that barely resolves the
+    /// excitation), from the shared set-up's checks.
+    pub warnings: Vec<String>,
 }
 
 /// A description of a run's ground motion for people: name, source, peak, sampling.
@@ -139,26 +142,9 @@ impl MotionInfo {
     }
 }
 
-/// Scales a ground motion to a peak acceleration of `pga_g` over `duration`; returns the
-/// scaled motion and the factor.
-fn scale_to_pga(motion: GroundMotion, pga_g: f64, duration: f64) -> Result<(GroundMotion, f64)> {
-    crate::error::require_positive("PGA", pga_g)?;
-    let peak = motion.peak_accel(duration) / crate::ground_motion::STANDARD_GRAVITY;
-    if peak.is_nan() || peak <= 0.0 {
-        return Err(Error::invalid(
-            "PGA",
-            "the ground motion is zero; there is nothing to scale",
-        ));
-    }
-    let factor = pga_g / peak;
-    let scaled = match motion {
-        GroundMotion::Record(r) => GroundMotion::Record(std::sync::Arc::new(r.scaled(factor)?)),
-        GroundMotion::Harmonic(h) => GroundMotion::Harmonic(Harmonic {
-            amplitude: h.amplitude * factor,
-            ..h
-        }),
-    };
-    Ok((scaled, factor))
+/// The label of a sliding model with joint friction `friction`.
+fn sliding_label(friction: f64) -> String {
+    format!("sliding base, ρ = {}", crate::post::format_number(friction))
 }
 
 /// The exact mass-spring solution of a two-block run, sampled for plotting.
@@ -176,194 +162,74 @@ pub struct ExactOverlay {
     pub roof_accel: Vec<f64>,
 }
 
-/// Builds the models of a configuration (shared by the thread, the render command and tests).
-pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
-    crate::error::require_positive("dt", config.dt)?;
-    crate::error::require_positive("frame interval", config.frame_dt)?;
-    let mut scene = resolve_scene(&config.scene)?;
-    if let Some(f) = config.friction
-        && (f.is_nan() || f < 0.0)
-    {
-        return Err(Error::invalid("friction", format!("must be >= 0, got {f}")));
-    }
-    let mut exact = None;
-    let (motion, roles_base, roles_roof, joint) = if let Some(roles) = scene.two_block.clone() {
-        let (amplitude_g, ratio) = match &config.excitation {
+impl SimConfig {
+    /// The run specification of this configuration (the shared set-up path of the command
+    /// line and the studies). A harmonic frequency is Ω/ω on a two-block scene and Hz on a
+    /// building, so the scene is loaded here once and handed over.
+    pub fn spec(&self) -> Result<RunSpec> {
+        crate::error::require_positive("frame interval", self.frame_dt)?;
+        let scene = crate::model::presets::resolve_scene(&self.scene)?;
+        let excitation = match &self.excitation {
+            Excitation::Scene => ExcitationSpec::Scene,
+            Excitation::Record(name) => ExcitationSpec::record(name.clone()),
             Excitation::Harmonic {
                 amplitude_g,
                 frequency,
-            } => (*amplitude_g, *frequency),
-            _ => (0.3, 1.0),
-        };
-        let params = TwoBlockParams {
-            alpha: config.alpha.unwrap_or(0.5),
-            friction: config.friction.unwrap_or(0.1),
-            freq_ratio: ratio,
-            amplitude_g,
-        };
-        apply_two_block(&mut scene, &params)?;
-        let motion = match &config.excitation {
-            Excitation::Record(name) => {
-                GroundMotion::Record(std::sync::Arc::new(resolve_record(name)?))
-            }
-            _ => GroundMotion::Harmonic(Harmonic::from_g_hz(
-                amplitude_g,
-                ratio * roles.structure_frequency_hz,
-            )?),
-        };
-        (
-            motion,
-            roles.raft.clone(),
-            roles.roof.clone(),
-            roles.joint.clone(),
-        )
-    } else if let Some(roles) = scene.structure.clone() {
-        if let Some(f) = config.friction {
-            for c in scene.contacts.iter_mut().filter(|c| c.name == roles.joint) {
-                c.friction = f;
-            }
-        }
-        let motion = match &config.excitation {
-            Excitation::Record(name) => {
-                GroundMotion::Record(std::sync::Arc::new(resolve_record(name)?))
-            }
-            Excitation::Harmonic {
-                amplitude_g,
-                frequency,
-            } => GroundMotion::Harmonic(Harmonic::from_g_hz(*amplitude_g, *frequency)?),
-            Excitation::Scene => match &scene.excitation {
-                ExcitationDef::Record { record, scale } => {
-                    let r = resolve_record(record)?;
-                    GroundMotion::Record(std::sync::Arc::new(if *scale != 1.0 {
-                        r.scaled(*scale)?
-                    } else {
-                        r
-                    }))
-                }
-                ExcitationDef::Harmonic {
-                    amplitude_g,
-                    frequency_hz,
-                } => GroundMotion::Harmonic(Harmonic::from_g_hz(*amplitude_g, *frequency_hz)?),
-                ExcitationDef::None => {
-                    return Err(Error::invalid(
-                        "excitation",
-                        "the scene has no ground motion",
-                    ));
-                }
+            } => ExcitationSpec::Harmonic {
+                amplitude_g: Some(*amplitude_g),
+                frequency: Some(if scene.two_block.is_some() {
+                    Frequency::Ratio(*frequency)
+                } else {
+                    Frequency::Hz(*frequency)
+                }),
             },
         };
-        let roof = roles
-            .floors
-            .last()
-            .cloned()
-            .unwrap_or_else(|| roles.base.clone());
-        (motion, roles.base.clone(), roof, roles.joint.clone())
-    } else {
-        return Err(Error::invalid(
-            "scene",
-            format!(
-                "scene '{}' declares no [two_block] or [structure] roles",
-                scene.name
-            ),
-        ));
-    };
-    let duration = match config.duration {
-        Some(d) => crate::error::require_positive("duration", d)?,
-        None => motion.duration().unwrap_or(20.0),
-    };
-    let (motion, scale) = match config.pga_g {
-        Some(pga) => scale_to_pga(motion, pga, duration)?,
-        None => (motion, 1.0),
-    };
-    let motion_info = MotionInfo::of(&motion, duration, scale);
-    let travel = (0..=400)
-        .map(|k| motion.displacement(duration * k as f64 / 400.0).abs())
-        .fold(0.0, f64::max);
-    extend_ground(&mut scene, 1.2 * travel + 10.0)?;
-    if let Some(roles) = &scene.two_block {
-        let alpha = config.alpha.unwrap_or(0.5);
-        let b = ShearBuilding::two_mass(
-            alpha,
-            roles.structure_frequency_hz,
-            config.friction.unwrap_or(0.1),
-        )?;
-        let r = simulate(
-            &b,
-            &motion,
-            duration,
-            config.frame_dt,
-            &ExactOptions::default(),
-        )?;
-        exact = Some(ExactOverlay {
-            slip: r.slip.clone(),
-            drift: r.storey_drift[0].clone(),
-            base_accel: r.raft_accel.clone(),
-            roof_accel: r.storey_accel[0].clone(),
-            time: r.time,
-        });
+        Ok(RunSpec {
+            scene: scene.into(),
+            excitation,
+            alpha: self.alpha,
+            friction: self.friction,
+            duration: self.duration,
+            dt: Some(self.dt),
+            integrator: Some(self.integrator),
+            pga_g: self.pga_g,
+            ..RunSpec::default()
+        })
     }
-    let params = SolverParams {
-        dt: config.dt,
-        duration,
-        integrator: config.integrator,
-        ..SolverParams::default()
-    };
+}
+
+/// Builds the models of a configuration (shared by the thread, the render command and
+/// tests), through the same set-up as the command line ([`RunSpec::prepare`]).
+pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
+    let setup = config.spec()?.prepare()?;
+    let exact = exact_overlay(&setup, config.frame_dt)?;
+    let motion_info = MotionInfo::of(&setup.motion, setup.duration, setup.motion_scale);
+    // The models: the main one, the friction comparisons, the fixed base; each a variant
+    // of the one set-up's scene.
+    let mut scenes = vec![(setup.scene.clone(), sliding_label(setup.friction))];
     for &f in &config.compare_friction {
-        if f.is_nan() || f < 0.0 {
-            return Err(Error::invalid(
-                "comparison friction",
-                format!("must be >= 0, got {f}"),
-            ));
-        }
+        scenes.push((setup.friction_variant_scene(f)?, sliding_label(f)));
     }
-    let main_friction = config.friction.or_else(|| {
-        scene
-            .contacts
-            .iter()
-            .find(|c| c.name == joint)
-            .map(|c| c.friction)
-    });
-    // (friction override, bonded joint) per model: the main model, the comparisons, the
-    // fixed base.
-    let mut variants: Vec<(Option<f64>, bool)> = vec![(None, false)];
-    variants.extend(config.compare_friction.iter().map(|&f| (Some(f), false)));
     if config.compare_fixed {
-        variants.push((None, true));
+        scenes.push((setup.fixed_base_scene(), "fixed base".to_string()));
     }
     let mut models = Vec::new();
     let mut labels = Vec::new();
-    for (friction, fixed) in variants {
-        let mut s = scene.clone();
-        for c in s.contacts.iter_mut().filter(|c| c.name == joint) {
-            if fixed {
-                c.bonded = true;
-            }
-            if let Some(f) = friction {
-                c.friction = f;
-            }
-        }
-        labels.push(if fixed {
-            "fixed base".to_string()
-        } else {
-            match friction.or(main_friction) {
-                Some(f) => format!("sliding base, ρ = {}", crate::post::format_number(f)),
-                None => "sliding base".to_string(),
-            }
-        });
-        let dda = Dda::new(&s, Some(motion.clone()), params.clone())?;
-        let base = dda.block_index(&roles_base)?;
-        let roof = dda.block_index(&roles_roof)?;
-        let ex = Extractor::new(&dda, base, roof);
+    for (scene, label) in &scenes {
+        let (dda, probe) = setup.build_dda(scene, setup.solver_params())?;
+        let ex = Extractor::new(&dda, probe.base, probe.roof);
+        labels.push(label.clone());
         models.push((dda, ex));
     }
     Ok(PreparedRun {
-        scene,
-        motion,
-        duration,
+        scene: setup.scene,
+        motion: setup.motion,
+        duration: setup.duration,
         models,
         labels,
         motion_info,
         exact,
+        warnings: setup.warnings,
     })
 }
 
@@ -447,6 +313,28 @@ pub fn run_to_messages(config: &SimConfig, until: f64) -> Result<Vec<SimMessage>
         wall_time_s: start.elapsed().as_secs_f64(),
     });
     Ok(messages)
+}
+
+/// The exact mass-spring solution of a two-block run, sampled every `frame_dt` seconds.
+fn exact_overlay(setup: &RunSetup, frame_dt: f64) -> Result<Option<ExactOverlay>> {
+    let Some((roles, alpha, _)) = setup.two_block() else {
+        return Ok(None);
+    };
+    let b = ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, setup.friction)?;
+    let r = simulate(
+        &b,
+        &setup.motion,
+        setup.duration,
+        frame_dt,
+        &ExactOptions::default(),
+    )?;
+    Ok(Some(ExactOverlay {
+        slip: r.slip.clone(),
+        drift: r.storey_drift[0].clone(),
+        base_accel: r.raft_accel.clone(),
+        roof_accel: r.storey_accel[0].clone(),
+        time: r.time,
+    }))
 }
 
 /// A frame of the run: the sliding model and, if run, the fixed-base one, at the same time.

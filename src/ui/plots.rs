@@ -9,7 +9,8 @@ use egui_plot::{Line, LineStyle, Plot, PlotPoints, VLine};
 
 use super::AppState;
 use crate::ground_motion::STANDARD_GRAVITY;
-use crate::post::spectrum::{SPECTRUM_DT, Spectrum, uniform_spectrum};
+use crate::headless::simulate::SPECTRUM_DT;
+use crate::post::spectrum::{Spectrum, uniform_spectrum};
 use crate::sim::Samples;
 use crate::{Error, Result};
 

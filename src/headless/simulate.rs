@@ -1,0 +1,269 @@
+//! Running a prepared setup: the DDA model of any scene, or the exact two-mass model, with
+//! the same peaks, counters and time histories, so that they compare point by point.
+
+use std::time::Instant;
+
+use crate::Result;
+use crate::analytic::ExactResult;
+use crate::dda::SolverParams;
+use crate::ground_motion::GroundMotion;
+use crate::limits::MAX_HISTORY_ROWS;
+use crate::model::Scene;
+use crate::post::history::{History, PeakTracker};
+use crate::post::spectrum::UniformSeries;
+use crate::setup::{ModelKind, RunSetup};
+
+/// Peak responses of a run, SI units.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Peaks {
+    /// max |u_s|: base slip relative to the ground, m.
+    pub slip_m: f64,
+    /// max |u_r|: roof relative to the base, m.
+    pub drift_m: f64,
+    /// max |absolute base acceleration|, m/s².
+    pub base_accel: f64,
+    /// max |absolute roof acceleration|, m/s².
+    pub roof_accel: f64,
+    /// max |ground acceleration| over the run, m/s².
+    pub ground_accel: f64,
+}
+
+/// Result of one run.
+#[derive(Debug, Clone)]
+pub struct ModelRun {
+    /// Which model.
+    pub model: ModelKind,
+    /// Peak values.
+    pub peaks: Peaks,
+    /// Slip at the end of the run, m.
+    pub residual_slip_m: f64,
+    /// Time steps (DDA) or propagation steps (mass-spring).
+    pub steps: u64,
+    /// Open-close passes (DDA only).
+    pub passes: u64,
+    /// Δt cuts (DDA only).
+    pub cuts: u64,
+    /// Numeric factorisations of the system matrix (DDA only).
+    pub factorizations: u64,
+    /// Steps that ended with a sliding contact (DDA only; the exact model reports its
+    /// slip phases through the slip history).
+    pub sliding_steps: u64,
+    /// Largest penetration / structure size (DDA only).
+    pub max_penetration_ratio: f64,
+    /// Energy residual relative to the energy that passed through the structure.
+    pub energy_residual_rel: f64,
+    /// Input work, J per m of thickness.
+    pub input_work: f64,
+    /// Friction dissipation, J per m.
+    pub friction_dissipated: f64,
+    /// Wall-clock time, s.
+    pub wall_time_s: f64,
+    /// Recorded histories, [`HISTORY_COLUMNS`] (empty when only peaks were asked for).
+    pub history: History,
+    /// The base acceleration resampled every [`SPECTRUM_DT`] seconds, for its spectrum
+    /// (DDA only).
+    pub base_accel_series: Option<UniformSeries>,
+}
+
+/// Columns of the recorded history.
+pub const HISTORY_COLUMNS: [&str; 6] = [
+    "time_s",
+    "ground_accel_m_s2",
+    "slip_m",
+    "roof_drift_m",
+    "base_accel_m_s2",
+    "roof_accel_m_s2",
+];
+
+/// Sample spacing of the base-acceleration series whose spectrum building runs report,
+/// s (Nyquist 100 Hz, far above the 20 Hz the peak is looked for in).
+pub const SPECTRUM_DT: f64 = 0.005;
+
+/// Most samples kept of that series (2²² = 5.8 h of run at 5 ms; longer runs keep every
+/// other sample, and so on).
+pub const SPECTRUM_MAX_SAMPLES: usize = 1 << 22;
+
+/// Runs the DDA model of `scene` (the setup's scene or a study's variant of it) under the
+/// setup's motion; the history is kept as the setup's plan says.
+pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<ModelRun> {
+    let start = Instant::now();
+    let duration = params.duration;
+    let (mut dda, probe) = setup.build_dda(scene, params)?;
+    let motion = &setup.motion;
+    let mut record_every = setup.history.stride();
+    let mut peaks = [PeakTracker::default(); 5];
+    let mut history = History::new(&HISTORY_COLUMNS);
+    let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
+    let mut step = 0usize;
+    let mut last_slip = 0.0;
+    let mut sliding_steps = 0;
+    dda.run_until(duration, |d, report| {
+        if report.sliding > 0 {
+            sliding_steps += 1;
+        }
+        let r = probe.measure(d, Some(motion));
+        let row = [
+            r.time,
+            r.ground_accel,
+            r.slip,
+            r.drift,
+            r.base_accel,
+            r.roof_accel,
+        ];
+        for (k, p) in peaks.iter_mut().enumerate() {
+            // Columns 1..5 are tracked as ground, slip, drift, base, roof.
+            p.offer(r.time, row[k + 1]);
+        }
+        series.push(r.time, r.base_accel);
+        if record_every > 0 && step.is_multiple_of(record_every) {
+            history.push(&row);
+            // Bounded memory: past the limit, every other row goes and the interval
+            // doubles (the kept rows are those of the doubled interval).
+            if history.len() >= MAX_HISTORY_ROWS {
+                history.decimate();
+                record_every *= 2;
+            }
+        }
+        step += 1;
+        last_slip = r.slip;
+    })?;
+    let counters = dda.counters();
+    let energy = dda.energy();
+    Ok(ModelRun {
+        model: ModelKind::Dda,
+        peaks: Peaks {
+            ground_accel: peaks[0].value,
+            slip_m: peaks[1].value,
+            drift_m: peaks[2].value,
+            base_accel: peaks[3].value,
+            roof_accel: peaks[4].value,
+        },
+        residual_slip_m: last_slip,
+        steps: counters.steps,
+        passes: counters.passes,
+        cuts: counters.cuts,
+        factorizations: counters.factorizations,
+        sliding_steps,
+        max_penetration_ratio: counters.max_penetration_ratio,
+        energy_residual_rel: dda.energy_residual_relative(),
+        input_work: energy.input_work,
+        friction_dissipated: energy.friction_dissipated,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        history,
+        base_accel_series: Some(series),
+    })
+}
+
+/// Runs the exact mass-spring model (paper Appendix I) with the same outputs as the DDA
+/// run; `output_dt` ≤ 0 records no history. Energies are scaled to `total_mass` (M + m).
+pub fn run_exact(
+    alpha: f64,
+    structure_freq_hz: f64,
+    total_mass: f64,
+    friction: f64,
+    motion: &GroundMotion,
+    duration: f64,
+    output_dt: f64,
+) -> Result<ModelRun> {
+    use crate::analytic::{ExactOptions, ShearBuilding, simulate};
+    let start = Instant::now();
+    let building = ShearBuilding::two_mass(alpha, structure_freq_hz, friction)?;
+    let r = simulate(
+        &building,
+        motion,
+        duration,
+        output_dt,
+        &ExactOptions::default(),
+    )?;
+    // The model has total mass 1: energies scale with the scene's M + m.
+    let e = r.energy;
+    let residual = if e.input_work.abs() > 0.0 {
+        e.residual / e.input_work.abs()
+    } else {
+        0.0
+    };
+    Ok(exact_model_run(
+        &r, motion, true, total_mass, residual, start,
+    ))
+}
+
+/// The exact model's result as a run: its peaks and counters, and (with `keep_history`)
+/// its outputs as a history of the top storey. Energies are multiplied by
+/// `energy_scale`; `energy_residual_rel` is the caller's.
+pub fn exact_model_run(
+    r: &ExactResult,
+    motion: &GroundMotion,
+    keep_history: bool,
+    energy_scale: f64,
+    energy_residual_rel: f64,
+    start: Instant,
+) -> ModelRun {
+    let top = r.storey_drift.len().saturating_sub(1);
+    let mut history = History::new(&HISTORY_COLUMNS);
+    if keep_history {
+        for k in 0..r.time.len() {
+            let t = r.time[k];
+            history.push(&[
+                t,
+                motion.accel(t),
+                r.slip[k],
+                r.storey_drift[top][k],
+                r.raft_accel[k],
+                r.storey_accel[top][k],
+            ]);
+        }
+    }
+    ModelRun {
+        model: ModelKind::MassSpring,
+        peaks: Peaks {
+            slip_m: r.peaks.slip,
+            drift_m: r.peaks.roof_drift,
+            base_accel: r.peaks.raft_accel,
+            roof_accel: r.peaks.roof_accel,
+            ground_accel: r.peaks.ground_accel,
+        },
+        residual_slip_m: r.residual_slip,
+        steps: r.steps,
+        passes: 0,
+        cuts: 0,
+        factorizations: 0,
+        sliding_steps: 0,
+        max_penetration_ratio: 0.0,
+        energy_residual_rel,
+        input_work: r.energy.input_work * energy_scale,
+        friction_dissipated: r.energy.friction_dissipated * energy_scale,
+        wall_time_s: start.elapsed().as_secs_f64(),
+        history,
+        base_accel_series: None,
+    }
+}
+
+/// The output interval of the exact model: `wanted`, or longer so that a long run keeps
+/// at most [`MAX_HISTORY_ROWS`] rows (0: no output).
+pub fn exact_output_dt(wanted: f64, duration: f64) -> f64 {
+    if wanted > 0.0 {
+        wanted.max(duration / MAX_HISTORY_ROWS as f64)
+    } else {
+        0.0
+    }
+}
+
+/// The exact model of a two-block setup (output every `output_dt` seconds, none if ≤ 0;
+/// longer for long runs, see [`exact_output_dt`]).
+pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
+    let (roles, alpha, _) = setup.two_block().ok_or_else(|| {
+        crate::Error::invalid(
+            "--model",
+            "the exact two-mass model needs a two-block scene",
+        )
+    })?;
+    run_exact(
+        alpha,
+        roles.structure_frequency_hz,
+        roles.total_mass,
+        setup.friction,
+        &setup.motion,
+        setup.duration,
+        exact_output_dt(output_dt, setup.duration),
+    )
+}

@@ -1,0 +1,283 @@
+//! The checks of a run specification, before and after its set-up: parameter ranges,
+//! options that do not apply to the scene or model (refused, never ignored), the size of
+//! the run against the limits, and whether Δt resolves what it must.
+
+use super::prepare::RunSetup;
+use super::spec::{ExcitationSpec, Frequency, ModelKind, RunSpec};
+use crate::error::{require_range, show};
+use crate::ground_motion::GroundMotion;
+use crate::limits::{
+    FREQUENCY_RANGE_HZ, MAX_ACCEL_G, MAX_FRICTION, MAX_STEPS, MIN_AMPLITUDE_G,
+    MIN_STEPS_PER_PERIOD, WARN_STEPS_PER_PERIOD,
+};
+use crate::model::Scene;
+use crate::{Error, Result};
+
+/// Ranges of the parameters the specification sets, named by their flags.
+pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
+    if let Some(dt) = spec.dt {
+        crate::error::require_positive("--dt", dt)?;
+    }
+    if let Some(d) = spec.duration {
+        crate::error::require_positive("--duration", d)?;
+    }
+    if let Some(a) = spec.alpha
+        && !(a > 0.0 && a < 1.0)
+    {
+        return Err(Error::invalid(
+            "--alpha",
+            format!(
+                "the mass ratio m/(M + m) must be in (0, 1), got {}",
+                show(a)
+            ),
+        ));
+    }
+    if let Some(f) = spec.friction {
+        if f == f64::INFINITY {
+            return Err(Error::invalid(
+                "--friction",
+                "inf: a joint that never slides is --fixed-base",
+            ));
+        }
+        require_range("--friction", f, 0.0, MAX_FRICTION, "")?;
+    }
+    if let Some(i) = spec.integrator {
+        i.validate()?;
+    }
+    if let Some(pga) = spec.pga_g {
+        require_range("--pga", pga, MIN_AMPLITUDE_G, MAX_ACCEL_G, "g")?;
+    }
+    match &spec.excitation {
+        ExcitationSpec::Scene => {}
+        ExcitationSpec::Harmonic {
+            amplitude_g,
+            frequency,
+        } => {
+            if let Some(a) = amplitude_g {
+                require_range("--amplitude-g", *a, MIN_AMPLITUDE_G, MAX_ACCEL_G, "g")?;
+            }
+            match frequency {
+                Some(Frequency::Ratio(r)) => {
+                    crate::error::require_positive("--freq-ratio", *r)?;
+                }
+                Some(Frequency::Hz(f)) => {
+                    let (lo, hi) = FREQUENCY_RANGE_HZ;
+                    require_range("frequency", *f, lo, hi, "Hz")?;
+                }
+                None => {}
+            }
+        }
+        ExcitationSpec::Record { source, scale } => {
+            if source.trim().is_empty() {
+                return Err(Error::invalid("--record", "names no record"));
+            }
+            require_range("record scale", *scale, 1e-6, 1e3, "")?;
+        }
+    }
+    Ok(())
+}
+
+/// Options that do not apply to this scene and model: refused, with what would apply.
+pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
+    let exact = spec.model == ModelKind::MassSpring;
+    if exact {
+        let why = "the exact mass-spring model has no time step, integrator or ground \
+                   block (it steps from event to event); it applies to --model dda";
+        for (given, flag) in [
+            (spec.dt.is_some(), "--dt"),
+            (spec.integrator.is_some(), "--integrator"),
+            (spec.ground.is_some(), "--ground"),
+        ] {
+            if given {
+                return Err(Error::invalid(flag, why));
+            }
+        }
+    }
+    if spec.fixed_base && spec.friction.is_some() {
+        return Err(Error::invalid(
+            "--friction",
+            "conflicts with --fixed-base: a fixed base never slides, whatever its friction",
+        ));
+    }
+    let building = scene.two_block.is_none();
+    if building {
+        if spec.alpha.is_some() {
+            return Err(Error::invalid(
+                "--alpha",
+                format!(
+                    "sets the mass ratio of the two-block scene; '{}' is a building (its \
+                     masses are its blocks')",
+                    scene.name
+                ),
+            ));
+        }
+        if let ExcitationSpec::Harmonic {
+            amplitude_g: Some(_),
+            frequency: None,
+        } = &spec.excitation
+            && !matches!(
+                scene.excitation,
+                crate::model::scene::ExcitationDef::Harmonic { .. }
+            )
+        {
+            return Err(Error::invalid(
+                "--amplitude-g",
+                format!(
+                    "sets the amplitude of harmonic input, but '{}' runs a record; scale a \
+                     record with `scale` in the scene's [excitation]",
+                    scene.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The number of steps the exact model takes: a 32nd of the shortest period of the stick
+/// and slip phases or the excitation, and every record sample.
+fn exact_steps(setup: &RunSetup) -> Option<f64> {
+    let (roles, alpha, _) = setup.two_block()?;
+    // The slip phase's structure frequency ω/√(1 − α) is the higher one.
+    let structure = roles.structure_frequency_hz / (1.0 - alpha).sqrt();
+    Some(exact_steps_for(structure, &setup.motion, setup.duration))
+}
+
+/// The exact model's steps for a highest natural frequency `f_max` (Hz).
+pub fn exact_steps_for(f_max: f64, motion: &GroundMotion, duration: f64) -> f64 {
+    let excitation = match motion {
+        GroundMotion::Harmonic(h) => h.omega / (2.0 * std::f64::consts::PI),
+        GroundMotion::Record(_) => 0.0,
+    };
+    let samples = match motion {
+        GroundMotion::Record(r) => duration.min(r.duration()) / r.dt,
+        GroundMotion::Harmonic(_) => 0.0,
+    };
+    32.0 * duration * f_max.max(excitation) + samples
+}
+
+/// Refuses a run whose step count is beyond [`MAX_STEPS`] unless confirmed.
+pub fn check_steps(steps: f64, what: &str, confirmed: bool) -> Result<()> {
+    if steps > MAX_STEPS && !confirmed {
+        // The fastest model (two blocks) takes about 3e5 steps per second.
+        let hours = steps / 3e5 / 3600.0;
+        return Err(Error::invalid(
+            "--duration/--dt",
+            format!(
+                "{what} would take {steps:.3e} steps, beyond the limit of {MAX_STEPS:e} \
+                 (at least {} h of computing at the two-block model's 3e5 steps/s); \
+                 shorten --duration, enlarge --dt, or give --confirm-large to run it anyway",
+                show(hours)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The size and resolution checks of a set-up: refusals as errors, the rest as warnings.
+pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<String>> {
+    let mut warnings = Vec::new();
+    if let GroundMotion::Record(r) = &setup.motion {
+        if r.is_vertical() {
+            return Err(Error::invalid(
+                "--record",
+                format!(
+                    "'{}' is a vertical component (its header says so); slidebase shakes \
+                     the ground horizontally: use a horizontal component",
+                    r.name
+                ),
+            ));
+        }
+        let peak = r.peak_accel(r.duration());
+        if peak < MIN_AMPLITUDE_G * crate::ground_motion::STANDARD_GRAVITY {
+            return Err(Error::record(
+                &r.name,
+                0,
+                format!(
+                    "its largest acceleration is {:.3e} g, below {MIN_AMPLITUDE_G:e} g: no \
+                     ground motion to run",
+                    peak / crate::ground_motion::STANDARD_GRAVITY
+                ),
+            ));
+        }
+    }
+    match setup.model {
+        ModelKind::Dda => {
+            let steps = setup.duration / setup.dt;
+            check_steps(steps, "the run", confirmed)?;
+            if setup.duration < setup.dt {
+                return Err(Error::invalid(
+                    "--duration",
+                    format!(
+                        "{} s is shorter than one time step Δt = {} s",
+                        setup.duration, setup.dt
+                    ),
+                ));
+            }
+            resolution(setup, &mut warnings)?;
+        }
+        ModelKind::MassSpring => {
+            if let Some(steps) = exact_steps(setup) {
+                check_steps(steps, "the exact model", confirmed)?;
+            }
+        }
+    }
+    Ok(warnings)
+}
+
+/// Δt against the shortest relevant periods: the excitation's, the two-block structure's
+/// (slip phase) and the record's sampling.
+fn resolution(setup: &RunSetup, warnings: &mut Vec<String>) -> Result<()> {
+    let dt = setup.dt;
+    let dts = show(dt);
+    let mut periods: Vec<(f64, String)> = Vec::new();
+    if let GroundMotion::Harmonic(h) = &setup.motion {
+        periods.push((
+            2.0 * std::f64::consts::PI / h.omega,
+            "the excitation's period".into(),
+        ));
+    }
+    if let Some((roles, alpha, _)) = setup.two_block() {
+        let f = roles.structure_frequency_hz / (1.0 - alpha).sqrt();
+        periods.push((1.0 / f, "the structure's period (slip phase)".into()));
+    }
+    for (period, what) in periods {
+        let per = period / dt;
+        if per < MIN_STEPS_PER_PERIOD {
+            return Err(Error::invalid(
+                "--dt",
+                format!(
+                    "Δt = {dts} s is {per:.3} steps per {what} ({period:.4e} s): the motion \
+                     cannot be represented; use Δt <= {:.3e} s",
+                    period / WARN_STEPS_PER_PERIOD
+                ),
+            ));
+        }
+        if per < WARN_STEPS_PER_PERIOD {
+            warnings.push(format!(
+                "Δt = {dts} s gives only {per:.1} steps per {what} ({period:.4e} s); results \
+                 are not resolved below Δt = {:.3e} s",
+                period / WARN_STEPS_PER_PERIOD
+            ));
+        }
+    }
+    if let GroundMotion::Record(r) = &setup.motion {
+        if dt > 5.0 * r.dt {
+            return Err(Error::invalid(
+                "--dt",
+                format!(
+                    "Δt = {dts} s skips more than 4 of every 5 samples of record '{}' \
+                     (sampled every {} s); use Δt <= {} s",
+                    r.name, r.dt, r.dt
+                ),
+            ));
+        }
+        if dt > r.dt {
+            warnings.push(format!(
+                "Δt = {dts} s is coarser than the sampling of record '{}' ({} s): the \
+                 samples between steps are not seen",
+                r.name, r.dt
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,451 @@
+//! From a [`RunSpec`] to a [`RunSetup`]: the scene with the parameters applied, the
+//! ground motion and everything else a run needs, built the same way for every front end.
+
+use std::sync::Arc;
+
+use super::response::Probe;
+use super::spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
+use super::{check, defaults};
+use crate::dda::{Dda, Integrator, SolverParams};
+use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
+use crate::model::Scene;
+use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground};
+use crate::model::scene::{ExcitationDef, StructureRoles, TwoBlockRoles};
+use crate::{Error, Result};
+
+/// What kind of scene a run is on, with its roles.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneRoles {
+    /// The paper's two-mass model (a `[two_block]` scene).
+    TwoBlock {
+        /// The scene's roles.
+        roles: TwoBlockRoles,
+        /// Mass ratio α = m/(M + m) as run.
+        alpha: f64,
+        /// Ω/ω of a harmonic excitation (`None` for a record).
+        freq_ratio: Option<f64>,
+    },
+    /// A building (a `[structure]` scene).
+    Building(StructureRoles),
+}
+
+/// A run ready to start: validated, with every default resolved.
+#[derive(Debug, Clone)]
+pub struct RunSetup {
+    /// The scene as run: parameters applied, ground long enough, joint bonded for a fixed
+    /// base.
+    pub scene: Scene,
+    /// The ground motion.
+    pub motion: GroundMotion,
+    /// Duration, s.
+    pub duration: f64,
+    /// DDA time step, s.
+    pub dt: f64,
+    /// DDA integrator.
+    pub integrator: Integrator,
+    /// DDA or the exact model.
+    pub model: ModelKind,
+    /// How much history to keep.
+    pub history: HistoryPlan,
+    /// The scene's roles.
+    pub roles: SceneRoles,
+    /// The base block (on the sliding joint).
+    pub base: String,
+    /// The roof block (top of the structure).
+    pub roof: String,
+    /// The sliding joint (contact name).
+    pub joint: String,
+    /// Friction coefficient of the sliding joint as run (∞ for a fixed base).
+    pub friction: f64,
+    /// Whether the joint is bonded.
+    pub fixed_base: bool,
+    /// `harmonic` or the record's name.
+    pub excitation_label: String,
+    /// Factor applied to the ground motion to reach [`RunSpec::pga_g`] (1: as given).
+    pub motion_scale: f64,
+    /// Things the user should know about the run (resolution, applicability).
+    pub warnings: Vec<String>,
+    /// The user confirmed a run beyond the step limit (`--confirm-large`).
+    pub confirm_large: bool,
+}
+
+impl RunSpec {
+    /// Checks the specification against its scene and builds the run. Nothing is solved
+    /// yet; every error a run can see before it starts is reported here.
+    pub fn prepare(&self) -> Result<RunSetup> {
+        check::check_ranges(self)?;
+        let scene = self.scene.load()?;
+        check::check_applicable(self, &scene)?;
+        let dt = self.dt.unwrap_or(defaults::DT);
+        let integrator = self.integrator.unwrap_or_default();
+        let mut setup = if let Some(roles) = scene.two_block.clone() {
+            self.two_block(scene, roles)?
+        } else if let Some(roles) = scene.structure.clone() {
+            self.building(scene, roles)?
+        } else {
+            return Err(Error::invalid(
+                "--scene",
+                format!(
+                    "scene '{}' declares no [two_block] or [structure] roles, so a run \
+                     does not know which blocks are the base and the roof",
+                    scene.name
+                ),
+            ));
+        };
+        setup.dt = dt;
+        setup.integrator = integrator;
+        if let Some(pga_g) = self.pga_g {
+            let (motion, factor) = scale_to_pga(&setup.motion, pga_g, setup.duration)?;
+            setup.motion = motion;
+            setup.motion_scale = factor;
+        }
+        // A sliding base travels at most as far as the ground moves: make sure the ground
+        // block is long enough.
+        let travel = max_abs_displacement(&setup.motion, setup.duration);
+        extend_ground(
+            &mut setup.scene,
+            defaults::GROUND_TRAVEL_FACTOR * travel + defaults::GROUND_MARGIN_M,
+        )?;
+        if self.fixed_base {
+            for c in setup.scene.contacts.iter_mut() {
+                if c.name == setup.joint {
+                    c.bonded = true;
+                }
+            }
+        }
+        if let Some(kind) = self.ground {
+            setup.scene.ground.kind = kind;
+        }
+        setup.warnings = check::check_setup(&setup, self.confirm_large)?;
+        Ok(setup)
+    }
+
+    /// The two-mass model: α, ρ, Ω/ω and the amplitude rescale the scene.
+    fn two_block(&self, mut scene: Scene, roles: TwoBlockRoles) -> Result<RunSetup> {
+        let alpha = match self.alpha {
+            Some(a) => a,
+            None => scene_alpha(&scene, &roles)?,
+        };
+        let joint_friction = joint_friction(&scene, &roles.joint);
+        let friction = if self.fixed_base {
+            f64::INFINITY
+        } else {
+            self.friction.unwrap_or(joint_friction)
+        };
+        let structure_hz = roles.structure_frequency_hz;
+        // The scene's own harmonic input, as (amplitude, Ω/ω).
+        let (scene_amplitude, scene_ratio) = match &scene.excitation {
+            ExcitationDef::Harmonic {
+                amplitude_g,
+                frequency_hz,
+            } => (*amplitude_g, frequency_hz / structure_hz),
+            _ => (defaults::AMPLITUDE_G, defaults::FREQ_RATIO),
+        };
+        let record = match &self.excitation {
+            ExcitationSpec::Record { source, scale } => Some((source.clone(), *scale)),
+            ExcitationSpec::Scene => match &scene.excitation {
+                ExcitationDef::Record { record, scale } => Some((record.clone(), *scale)),
+                _ => None,
+            },
+            ExcitationSpec::Harmonic { .. } => None,
+        };
+        let (amplitude_g, ratio) = match &self.excitation {
+            ExcitationSpec::Harmonic {
+                amplitude_g,
+                frequency,
+            } => (
+                amplitude_g.unwrap_or(scene_amplitude),
+                match frequency {
+                    Some(Frequency::Ratio(r)) => *r,
+                    Some(Frequency::Hz(f)) => f / structure_hz,
+                    None => scene_ratio,
+                },
+            ),
+            _ => (scene_amplitude, scene_ratio),
+        };
+        let (lo, hi) = crate::limits::FREQUENCY_RANGE_HZ;
+        let hz = ratio * structure_hz;
+        if record.is_none() && !(ratio.is_finite() && (lo..=hi).contains(&hz)) {
+            return Err(Error::invalid(
+                "--freq-ratio",
+                format!(
+                    "Ω/ω = {} is {} Hz for this structure ({} Hz); the excitation frequency \
+                     must be in [{lo:e}, {hi}] Hz",
+                    crate::error::show(ratio),
+                    crate::error::show(hz),
+                    structure_hz
+                ),
+            ));
+        }
+        let params = TwoBlockParams {
+            alpha,
+            friction,
+            freq_ratio: ratio,
+            amplitude_g,
+        };
+        params.validate()?;
+        apply_two_block(&mut scene, &params)?;
+        let (motion, freq_ratio, excitation_label) = match record {
+            None => (
+                GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude_g, ratio * structure_hz)?),
+                Some(ratio),
+                "harmonic".to_string(),
+            ),
+            Some((source, scale)) => {
+                let r = load_record(&source, scale)?;
+                let label = r.name.clone();
+                scene.excitation = ExcitationDef::Record {
+                    record: source,
+                    scale,
+                };
+                (GroundMotion::Record(Arc::new(r)), None, label)
+            }
+        };
+        let blocks = [roles.raft.clone(), roles.roof.clone(), roles.joint.clone()];
+        let roles = SceneRoles::TwoBlock {
+            roles,
+            alpha,
+            freq_ratio,
+        };
+        Ok(self.setup(scene, motion, roles, blocks, friction, excitation_label))
+    }
+
+    /// The set-up of a scene whose parameters are applied; `blocks` are the base, the roof
+    /// and the sliding joint.
+    fn setup(
+        &self,
+        scene: Scene,
+        motion: GroundMotion,
+        roles: SceneRoles,
+        blocks: [String; 3],
+        friction: f64,
+        excitation_label: String,
+    ) -> RunSetup {
+        let duration = self
+            .duration
+            .or(motion.duration())
+            .unwrap_or(defaults::HARMONIC_DURATION_S);
+        let [base, roof, joint] = blocks;
+        RunSetup {
+            scene,
+            motion,
+            duration,
+            dt: defaults::DT,
+            integrator: Integrator::default(),
+            model: self.model,
+            history: self.history,
+            roles,
+            base,
+            roof,
+            joint,
+            friction,
+            fixed_base: self.fixed_base,
+            excitation_label,
+            motion_scale: 1.0,
+            warnings: Vec::new(),
+            confirm_large: self.confirm_large,
+        }
+    }
+
+    /// A building: friction, fixed base and excitation set on the scene as it is.
+    fn building(&self, mut scene: Scene, roles: StructureRoles) -> Result<RunSetup> {
+        if let Some(f) = self.friction {
+            for c in scene.contacts.iter_mut().filter(|c| c.name == roles.joint) {
+                c.friction = f;
+            }
+        }
+        let motion = match (&self.excitation, &scene.excitation) {
+            (ExcitationSpec::Record { source, scale }, _)
+            | (
+                ExcitationSpec::Scene,
+                ExcitationDef::Record {
+                    record: source,
+                    scale,
+                },
+            ) => GroundMotion::Record(Arc::new(load_record(source, *scale)?)),
+            (
+                ExcitationSpec::Scene,
+                ExcitationDef::Harmonic {
+                    amplitude_g,
+                    frequency_hz,
+                },
+            ) => GroundMotion::Harmonic(Harmonic::from_g_hz(*amplitude_g, *frequency_hz)?),
+            (ExcitationSpec::Scene, ExcitationDef::None) => {
+                return Err(Error::invalid(
+                    "--record",
+                    "the scene has no ground motion; give one with --record",
+                ));
+            }
+            (
+                ExcitationSpec::Harmonic {
+                    amplitude_g,
+                    frequency,
+                },
+                own,
+            ) => {
+                let (own_amplitude, own_hz) = match own {
+                    ExcitationDef::Harmonic {
+                        amplitude_g,
+                        frequency_hz,
+                    } => (Some(*amplitude_g), Some(*frequency_hz)),
+                    _ => (None, None),
+                };
+                let hz = match frequency {
+                    Some(Frequency::Hz(f)) => *f,
+                    Some(Frequency::Ratio(_)) => {
+                        return Err(Error::invalid(
+                            "--freq-ratio",
+                            format!(
+                                "a frequency ratio needs a two-block scene's structure \
+                                 frequency; '{}' is a building (give the frequency in Hz)",
+                                scene.name
+                            ),
+                        ));
+                    }
+                    None => own_hz.ok_or_else(|| {
+                        Error::invalid(
+                            "frequency",
+                            "the scene's excitation is not harmonic; give the frequency in Hz",
+                        )
+                    })?,
+                };
+                let amplitude = amplitude_g
+                    .or(own_amplitude)
+                    .unwrap_or(defaults::AMPLITUDE_G);
+                GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude, hz)?)
+            }
+        };
+        let friction = if self.fixed_base {
+            f64::INFINITY
+        } else {
+            joint_friction(&scene, &roles.joint)
+        };
+        let roof = roles.floors.last().unwrap_or(&roles.base).clone();
+        let blocks = [roles.base.clone(), roof, roles.joint.clone()];
+        let label = motion.label();
+        Ok(self.setup(
+            scene,
+            motion,
+            SceneRoles::Building(roles),
+            blocks,
+            friction,
+            label,
+        ))
+    }
+}
+
+impl RunSetup {
+    /// The solver parameters of the run (the solver's own defaults otherwise).
+    pub fn solver_params(&self) -> SolverParams {
+        SolverParams {
+            dt: self.dt,
+            duration: self.duration,
+            integrator: self.integrator,
+            ..SolverParams::default()
+        }
+    }
+
+    /// The DDA model of `scene` (the run's scene or a variant of it) under the run's
+    /// motion, with the blocks it is measured on.
+    pub fn build_dda(&self, scene: &Scene, params: SolverParams) -> Result<(Dda, Probe)> {
+        let dda = Dda::new(scene, Some(self.motion.clone()), params)?;
+        let probe = Probe {
+            base: dda.block_index(&self.base)?,
+            roof: dda.block_index(&self.roof)?,
+        };
+        Ok((dda, probe))
+    }
+
+    /// The run's scene with the sliding joint bonded (the fixed-base comparison).
+    pub fn fixed_base_scene(&self) -> Scene {
+        let mut scene = self.scene.clone();
+        for c in scene.contacts.iter_mut().filter(|c| c.name == self.joint) {
+            c.bonded = true;
+        }
+        scene
+    }
+
+    /// The run's scene with the sliding joint's friction coefficient set to `friction`
+    /// (a side-by-side comparison of friction values).
+    pub fn friction_variant_scene(&self, friction: f64) -> Result<Scene> {
+        crate::error::require_range(
+            "comparison friction",
+            friction,
+            0.0,
+            crate::limits::MAX_FRICTION,
+            "",
+        )?;
+        let mut scene = self.scene.clone();
+        for c in scene.contacts.iter_mut().filter(|c| c.name == self.joint) {
+            c.friction = friction;
+        }
+        Ok(scene)
+    }
+
+    /// The two-block roles, α and Ω/ω, when this is a two-block run.
+    pub fn two_block(&self) -> Option<(&TwoBlockRoles, f64, Option<f64>)> {
+        match &self.roles {
+            SceneRoles::TwoBlock {
+                roles,
+                alpha,
+                freq_ratio,
+            } => Some((roles, *alpha, *freq_ratio)),
+            SceneRoles::Building(_) => None,
+        }
+    }
+}
+
+/// α = m/(M + m) of a two-block scene as written (roof and raft masses).
+fn scene_alpha(scene: &Scene, roles: &TwoBlockRoles) -> Result<f64> {
+    let mass = |name: &str| -> Result<f64> {
+        let b = &scene.blocks[scene.block_index(name)?];
+        Ok(b.material.density * crate::model::geometry::moments(&b.vertices, &b.name)?.area)
+    };
+    let (m, big_m) = (mass(&roles.roof)?, mass(&roles.raft)?);
+    Ok(m / (m + big_m))
+}
+
+/// The friction coefficient of the named joint (0 if the scene has none of that name; the
+/// scene's validation makes sure it has).
+fn joint_friction(scene: &Scene, joint: &str) -> f64 {
+    scene
+        .contacts
+        .iter()
+        .find(|c| c.name == joint)
+        .map_or(0.0, |c| c.friction)
+}
+
+/// A record by name or file, scaled.
+fn load_record(source: &str, scale: f64) -> Result<crate::ground_motion::Record> {
+    let r = resolve_record(source)?;
+    if scale != 1.0 { r.scaled(scale) } else { Ok(r) }
+}
+
+/// Largest |ground displacement| over [0, duration] (sampled finely enough for a bound).
+fn max_abs_displacement(motion: &GroundMotion, duration: f64) -> f64 {
+    let n = defaults::GROUND_TRAVEL_SAMPLES;
+    (0..=n)
+        .map(|k| motion.displacement(duration * k as f64 / n as f64).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The ground motion scaled to a peak acceleration of `pga_g` over `duration`, and the
+/// factor applied.
+fn scale_to_pga(motion: &GroundMotion, pga_g: f64, duration: f64) -> Result<(GroundMotion, f64)> {
+    let peak = motion.peak_accel(duration) / crate::ground_motion::STANDARD_GRAVITY;
+    if !(peak.is_finite() && peak > 0.0) {
+        return Err(Error::invalid(
+            "--pga",
+            "the ground motion is zero over the run; there is nothing to scale",
+        ));
+    }
+    let factor = pga_g / peak;
+    let scaled = match motion {
+        GroundMotion::Record(r) => GroundMotion::Record(Arc::new(r.scaled(factor)?)),
+        GroundMotion::Harmonic(h) => GroundMotion::Harmonic(Harmonic {
+            amplitude: h.amplitude * factor,
+            ..*h
+        }),
+    };
+    Ok((scaled, factor))
+}
