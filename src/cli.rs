@@ -33,7 +33,8 @@ enum Command {
     Modes(ModesArgs),
     /// The paper's seismic case: sliding against fixed base, figures like Figs 10–18.
     Report(ReportArgs),
-    /// Render the scene at one instant into a PNG (offscreen, the visualizer's renderer).
+    /// Render the scene at one instant into a PNG, or a replay into an MP4/GIF (offscreen,
+    /// the visualizer's renderer; --data also writes the plotted data as CSV).
     Render(RenderArgs),
     /// Error against run time: time step, integrator, penalty and ground model.
     Accuracy(AccuracyArgs),

@@ -262,3 +262,42 @@ fn pga_scaling_and_friction_variants_go_through_the_run_setup() {
         .to_string();
     assert!(e.contains("comparison friction"), "{e}");
 }
+
+/// Issue 12, finding 1 and "Camera": on the default scene at 1600×900, with nothing done
+/// by the user, the peak slip (0.167 m at 2.55 s) spans at least 40 px somewhere on
+/// screen — in the joint close-up. The scene area is the central panel of a 1600×900
+/// window with the default panels (810 × 750 px, measured on the screenshot
+/// docs/screenshots/visualizer_scrubbed.png).
+#[test]
+fn peak_slip_spans_40_px_in_the_default_view() {
+    use slidebase::render::layout::layout;
+    let until = 4.0;
+    let config = SimConfig {
+        duration: Some(until),
+        ..SimConfig::default()
+    };
+    let mut state = state_until(&config, until, &PictureOptions::default()).unwrap();
+    let slip = &state.timeline.samples[0].slip;
+    let peak = slip.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    assert!(
+        peak > 0.15,
+        "peak slip {peak} m (El Centro, ρ = 0.01: 0.167 m)"
+    );
+    state.play_time = 2.55;
+    let inputs = slidebase::ui::scene::inputs_of(&mut state).unwrap();
+    assert!(inputs.close_ups, "the close-ups are on by default");
+    let lay = layout(
+        &inputs.frames.models,
+        &inputs.fits,
+        &inputs.camera,
+        inputs.slip_scale,
+        [310.0, 70.0, 810.0, 750.0],
+        inputs.close_ups,
+    );
+    let view = lay.close_up_views[0].unwrap();
+    let px = peak as f32 / view.metres_per_pixel;
+    assert!(px >= 40.0, "peak slip spans {px} px in the close-up");
+    // And the main view alone would not show it (the reason for the close-up).
+    let main = peak as f32 / lay.views[0].metres_per_pixel;
+    assert!(main < px / 5.0, "main view {main} px, close-up {px} px");
+}

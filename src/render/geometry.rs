@@ -39,7 +39,8 @@ pub struct Layers {
     pub slip: bool,
     /// Bolts.
     pub bolts: bool,
-    /// Connection elements.
+    /// Outlines of the connection elements (their material is always drawn with the
+    /// blocks: it is what joins a column to a slab).
     pub connections: bool,
     /// Ground and its markings.
     pub ground: bool,
@@ -53,7 +54,8 @@ impl Default for Layers {
             contacts: true,
             slip: true,
             bolts: true,
-            connections: true,
+            // Off by default: triangles drawn inside a joint look like bracing.
+            connections: false,
             ground: true,
         }
     }
@@ -450,6 +452,27 @@ fn draw_panel(p: &mut Painter<'_>, panel: &PanelView<'_>, view: &SceneView<'_>) 
         p.polygon(ghost, GHOST_FILL);
         dashed_outline(p, ghost, 2.0, 8.0, GHOST_LINE);
     }
+    // The connection elements are elastic material between the blocks they join: filled
+    // like an unstrained block, so that a column and its slab read as one structure.
+    let connections: Vec<Vec<[f32; 2]>> = frame
+        .connections
+        .iter()
+        .map(|c| {
+            (0..3)
+                .map(|k| exaggerate(c.rigid[k], c.points[k], factor))
+                .collect()
+        })
+        .collect();
+    if view.layers.blocks {
+        let fill = match view.color_by {
+            _ if panel.close_up => MATERIAL,
+            ColorBy::Material => MATERIAL,
+            _ => colormap(0.0),
+        };
+        for pts in &connections {
+            p.polygon(pts, fill);
+        }
+    }
     for blk in frame.blocks.iter().filter(|b| !b.is_ground) {
         let pts: Vec<[f32; 2]> = blk
             .rigid
@@ -475,11 +498,8 @@ fn draw_panel(p: &mut Painter<'_>, panel: &PanelView<'_>, view: &SceneView<'_>) 
         }
     }
     if view.layers.connections {
-        for c in &frame.connections {
-            let pts: Vec<[f32; 2]> = (0..3)
-                .map(|k| exaggerate(c.rigid[k], c.points[k], factor))
-                .collect();
-            p.outline(&pts, 1.0, CONNECTION);
+        for pts in &connections {
+            p.outline(pts, 1.0, CONNECTION);
         }
     }
     if view.layers.bolts {

@@ -227,15 +227,20 @@ impl AppState {
                 _ => Comparison::Friction(others.clone()),
             };
         }
-        if let Comparison::Friction(f) | Comparison::FrictionAndFixed(f) = c
-            && let Some(first) = f.first_mut()
-        {
-            ui.add(
-                egui::Slider::new(first, 0.001..=1.0)
-                    .logarithmic(true)
-                    .text("second ρ"),
-            )
-            .on_hover_text("the friction coefficient of the model beside it");
+        if let Comparison::Friction(f) | Comparison::FrictionAndFixed(f) = c {
+            // One slider per compared model (a preset can compare several).
+            let names = ["second ρ", "third ρ", "fourth ρ", "fifth ρ"];
+            for (k, rho) in f.iter_mut().enumerate() {
+                ui.add(
+                    egui::Slider::new(rho, 0.001..=1.0)
+                        .logarithmic(true)
+                        .text(names.get(k).copied().unwrap_or("another ρ")),
+                )
+                .on_hover_text(format!(
+                    "the friction coefficient of model {} from the left",
+                    k + 2
+                ));
+            }
         }
     }
 
@@ -365,7 +370,10 @@ impl AppState {
             ui.checkbox(&mut l.bolts, "springs")
                 .on_hover_text("bolts and springs between blocks");
             ui.checkbox(&mut l.connections, "connections")
-                .on_hover_text("the connection elements that join columns to slabs");
+                .on_hover_text(
+                    "outline the connection elements: the elastic triangles that join \
+                     columns to slabs (always drawn filled with the blocks)",
+                );
             ui.checkbox(&mut l.ground, "ground")
                 .on_hover_text("the ground and its marks");
         });

@@ -617,7 +617,11 @@ impl AppState {
                 .resizable(true)
                 .default_size((0.3 * width).clamp(300.0, 620.0))
                 .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| plots::plots_ui(self, ui));
+                    // Not shrunk to the content: with every plot folded the panel kept
+                    // shrinking, and unfolding them then gave plots 150 px wide.
+                    egui::ScrollArea::vertical()
+                        .auto_shrink([false, false])
+                        .show(ui, |ui| plots::plots_ui(self, ui));
                 });
         }
         egui::CentralPanel::default()

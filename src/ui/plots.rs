@@ -45,7 +45,8 @@ pub struct Curve {
     pub points: Vec<[f64; 2]>,
     /// Colour (None: the theme's text colour, for the ground).
     pub color: Option<egui::Color32>,
-    /// Dashed (the exact solution).
+    /// Dashed, and drawn over the solid curves (the exact solution; the ground's
+    /// spectrum).
     pub dashed: bool,
     /// Largest |y| (for the legend).
     pub peak: f64,
@@ -203,7 +204,11 @@ impl PlotData {
                         .filter(|(f, _)| **f <= 10.0)
                         .map(|(f, a)| [*f, *a])
                         .collect();
-                    d.spectrum.push(curve(name, pts, color));
+                    let mut c = curve(name, pts, color);
+                    // The ground's spectrum is the fixed base's (a bonded base moves with
+                    // the ground): dashed and drawn on top, it stays visible.
+                    c.dashed = color.is_none();
+                    d.spectrum.push(c);
                     d.spectrum_peaks.push(peak);
                 }
             };
@@ -300,7 +305,9 @@ fn plot(
         .include_x(0.0)
         .include_x(cursor.map_or(0.0, |c| c.1))
         .show(ui, |p| {
-            for c in curves {
+            let (solid, dashed): (Vec<&Curve>, Vec<&Curve>) =
+                curves.iter().partition(|c| !c.dashed);
+            for c in solid.into_iter().chain(dashed) {
                 let mut line = Line::new(c.name.clone(), PlotPoints::new(c.points.clone()))
                     .color(c.color.unwrap_or(text_color))
                     .width(if c.color.is_none() { 1.0 } else { 1.5 });

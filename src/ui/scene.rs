@@ -235,7 +235,7 @@ fn model_labels(
                 title.size().y + g_readout.size().y + 6.0,
             ),
         );
-        painter.rect_filled(back, 3.0, egui::Color32::from_white_alpha(170));
+        painter.rect_filled(back, 3.0, egui::Color32::from_white_alpha(230));
         painter.galley(pos, title.clone(), color);
         painter.galley(pos + egui::vec2(0.0, title.size().y + 2.0), g_readout, INK);
         if k > 0 {
@@ -294,7 +294,7 @@ fn close_up_labels(
                 title.size() + egui::vec2(6.0, 2.0),
             ),
             3.0,
-            egui::Color32::from_white_alpha(170),
+            egui::Color32::from_white_alpha(230),
         );
         painter.galley(pos, title, INK);
         // Scale bar: about a quarter of the width, a round length.

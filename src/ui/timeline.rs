@@ -5,7 +5,7 @@
 use super::AppState;
 
 /// Height of the rail, points.
-const RAIL_HEIGHT: f32 = 26.0;
+const RAIL_HEIGHT: f32 = 34.0;
 
 impl AppState {
     pub(super) fn timeline_ui(&mut self, ui: &mut egui::Ui) {
@@ -52,32 +52,37 @@ impl AppState {
                     .strong(),
             ))
             .on_hover_text("the time shown, simulated seconds from the start of the record");
-            // The rail takes what the right-hand controls leave.
-            let right = 250.0;
-            let width = (ui.available_width() - right).max(120.0);
-            self.rail(ui, width);
-            egui::ComboBox::from_id_salt("speed")
-                .selected_text(format!("{}×", self.speed))
-                .width(58.0)
-                .show_ui(ui, |ui| {
-                    for s in [0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0] {
-                        ui.selectable_value(&mut self.speed, s, format!("{s}×"));
-                    }
-                })
-                .response
-                .on_hover_text("playback speed: simulated seconds per second");
-            ui.checkbox(&mut self.looping, "loop")
-                .on_hover_text("start again at the end");
-            let computed = self.timeline.available();
-            let total = self.timeline.duration;
-            let text = if self.timeline.finished {
-                format!("{total:.1} s")
-            } else {
-                format!("computing {computed:.1} / {total:.1} s")
-            };
-            ui.label(text).on_hover_text(
-                "how much of the run the simulation has computed (it runs ahead in the background)",
-            );
+            // Right to left: the status, loop and speed keep their room at any width (a
+            // fixed reservation clipped "computing 23.0 / 31.2 s"), the rail takes the rest.
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                let computed = self.timeline.available();
+                let total = self.timeline.duration;
+                let text = if self.timeline.finished {
+                    format!("run {total:.1} s")
+                } else {
+                    format!("computing {computed:.1} / {total:.1} s")
+                };
+                ui.label(text).on_hover_text(
+                    "how much of the run the simulation has computed (it runs ahead in the \
+                     background)",
+                );
+                ui.checkbox(&mut self.looping, "loop")
+                    .on_hover_text("start again at the end");
+                egui::ComboBox::from_id_salt("speed")
+                    .selected_text(format!("{}×", self.speed))
+                    .width(58.0)
+                    .show_ui(ui, |ui| {
+                        for s in [0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0] {
+                            ui.selectable_value(&mut self.speed, s, format!("{s}×"));
+                        }
+                    })
+                    .response
+                    .on_hover_text("playback speed: simulated seconds per second");
+                let width = (ui.available_width() - 12.0).max(120.0);
+                ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
+                    self.rail(ui, width);
+                });
+            });
         });
         ui.add_space(2.0);
     }
@@ -105,9 +110,11 @@ impl AppState {
         }
         let painter = ui.painter_at(rect.expand(2.0));
         let visuals = ui.visuals();
+        // The track in the upper part, the seconds under it (inside the rail, unclipped).
+        let track_y = rect.top() + 10.0;
         let track = egui::Rect::from_min_max(
-            egui::pos2(rect.left(), rect.center().y - 4.0),
-            egui::pos2(rect.right(), rect.center().y + 4.0),
+            egui::pos2(rect.left(), track_y - 4.0),
+            egui::pos2(rect.right(), track_y + 4.0),
         );
         painter.rect_filled(track, 3.0, visuals.extreme_bg_color);
         let computed = egui::Rect::from_min_max(
@@ -134,26 +141,28 @@ impl AppState {
             );
             if major && x + 20.0 < rect.right() {
                 painter.text(
-                    egui::pos2(x, rect.bottom() + 1.0),
-                    egui::Align2::CENTER_BOTTOM,
-                    format!("{s}"),
-                    egui::FontId::proportional(10.0),
-                    visuals.weak_text_color(),
+                    egui::pos2(x, track.max.y + h + 1.0),
+                    // The first label starts at the rail's left end (centred, it was cut).
+                    if s == 0 {
+                        egui::Align2::LEFT_TOP
+                    } else {
+                        egui::Align2::CENTER_TOP
+                    },
+                    format!("{s} s"),
+                    egui::FontId::proportional(12.0),
+                    visuals.text_color(),
                 );
             }
         }
         let x = x_of(self.play_time);
         painter.line_segment(
-            [
-                egui::pos2(x, rect.top()),
-                egui::pos2(x, rect.bottom() - 6.0),
-            ],
+            [egui::pos2(x, rect.top()), egui::pos2(x, track.max.y + 6.0)],
             egui::Stroke::new(3.0, visuals.strong_text_color()),
         );
         if let Some(target) = self.resume_at {
             let xt = x_of(target);
             painter.circle_stroke(
-                egui::pos2(xt, rect.center().y),
+                egui::pos2(xt, track_y),
                 6.0,
                 egui::Stroke::new(2.0, visuals.warn_fg_color),
             );
