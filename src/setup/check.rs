@@ -44,6 +44,9 @@ pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
     if let Some(i) = spec.integrator {
         i.validate()?;
     }
+    if let Some(pga) = spec.pga_g {
+        require_range("--pga", pga, MIN_AMPLITUDE_G, MAX_ACCEL_G, "g")?;
+    }
     match &spec.excitation {
         ExcitationSpec::Scene => {}
         ExcitationSpec::Harmonic {
