@@ -125,6 +125,25 @@ fn a_slip_that_continues_the_same_way_stops_later() {
     assert!(r.energy.residual.abs() < 1e-8 * r.energy.input_work);
 }
 
+/// Where the raft never slides the input work is ~0 (the ground gives back what it put
+/// in); the residual was divided by it and came out as ±1. Relative to the energy that
+/// passed through (the largest stored energy), the balance must close like anywhere else.
+#[test]
+fn energy_residual_is_defined_where_nothing_slides() {
+    let b = ShearBuilding::two_mass(0.5, 1.0, 0.25).unwrap();
+    let (_, g) = harmonic(10.0);
+    let r = simulate(&b, &g, 100.0, 0.0, &ExactOptions::default()).unwrap();
+    // The first event is the initial phase.
+    assert_eq!(
+        r.events.len(),
+        1,
+        "0.3 g against ρ = 0.25 at Ω/ω = 10 never slides"
+    );
+    let e = r.energy;
+    assert!(e.scale > 1e3 * e.input_work.abs(), "{e:?}");
+    assert!(e.residual_relative().abs() < 1e-8, "{e:?}");
+}
+
 /// Tightening every numerical tolerance does not change the paper's metrics.
 #[test]
 fn tighter_tolerances_change_nothing() {
