@@ -43,6 +43,18 @@ class Case:
         self.timeout = timeout or TIMEOUT_S
 
 
+def record_file_cases(tmp, category, ext, table):
+    """One `run --record` case per (name, file text) of `table`, written to `tmp`; a
+    name containing "valid" must run, every other one must be refused."""
+    out = []
+    for name, text in table.items():
+        path = tmp / ("rec-%s.%s" % (re.sub(r"\W+", "-", name), ext))
+        path.write_text(text, encoding="utf-8")
+        expect = "ok" if "valid" in name else "error"
+        out.append(Case(category, name, ["run", "--record", str(path), "--model", "mass-spring", "--json"], expect))
+    return out
+
+
 def limit_memory():
     try:
         import resource
@@ -200,11 +212,7 @@ def record_cases(rng, tmp):
         ("Fortran D, CRLF, BOM (valid)", "\ufeffh\r\nh\r\nh\r\nNPTS= 4, DT= .01 SEC\r\n 1.0D-01 -2.0d-1\t0.1D0 0\r\n\r\n"),
         ("legacy header (valid)", "h\nh\nh\n  4   .01000   NPTS, DT\n0.1 0.2 0.1 0\n"),
     ])
-    for name, text in at2.items():
-        path = tmp / ("rec-%s.at2" % re.sub(r"\W+", "-", name))
-        path.write_text(text, encoding="utf-8")
-        ok = "valid" in name
-        cases.append(Case("AT2 record", name, ["run", "--record", str(path), "--model", "mass-spring", "--json"], "ok" if ok else "error"))
+    cases.extend(record_file_cases(tmp, "AT2 record", "at2", at2))
     csv = OrderedDict([
         ("BOM first row (valid)", "\ufeff0.0,0.9\n0.01,0.1\n0.02,0.0\n0.03,0.0\n"),
         ("CRLF tabs header (valid)", "time_s\taccel_g\r\n0\t0.1\r\n0.01\t0.2\r\n0.02\t0.0\r\n\r\n"),
@@ -222,11 +230,7 @@ def record_cases(rng, tmp):
         ("vertical comment", "# component: UP (vertical)\n0,0.1\n0.01,0.2\n0.02,0.1\n"),
         ("only comments", "# a\n# b\n"),
     ])
-    for name, text in csv.items():
-        path = tmp / ("rec-%s.csv" % re.sub(r"\W+", "-", name))
-        path.write_text(text, encoding="utf-8")
-        ok = "valid" in name
-        cases.append(Case("CSV record", name, ["run", "--record", str(path), "--model", "mass-spring", "--json"], "ok" if ok else "error"))
+    cases.extend(record_file_cases(tmp, "CSV record", "csv", csv))
     # Mutants of a real record.
     lines = (ROOT / "assets/records/el_centro_1940_ns.csv").read_text().splitlines()[:80]
     for k in range(60):

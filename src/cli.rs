@@ -33,7 +33,8 @@ enum Command {
     Modes(ModesArgs),
     /// The paper's seismic case: sliding against fixed base, figures like Figs 10–18.
     Report(ReportArgs),
-    /// Render the scene at one instant into a PNG (offscreen, the visualizer's renderer).
+    /// Render the scene at one instant into a PNG, or a replay into an MP4/GIF (offscreen,
+    /// the visualizer's renderer; --data also writes the plotted data as CSV).
     Render(RenderArgs),
     /// Error against run time: time step, integrator, penalty and ground model.
     Accuracy(AccuracyArgs),
@@ -173,33 +174,54 @@ struct AccuracyArgs {
 
 #[derive(Debug, clap::Args)]
 struct RenderArgs {
-    /// Scene (built-in name or TOML file).
+    /// Scene (built-in name, frame:N, wall:N or a TOML file).
     #[arg(long, default_value = "three-storey")]
     scene: String,
     /// Record (built-in name or file; default: the scene's).
     #[arg(long)]
     record: Option<String>,
+    /// Scale the record to this peak ground acceleration, g.
+    #[arg(long, allow_hyphen_values = true)]
+    pga: Option<f64>,
     /// Friction coefficient of the sliding joint.
     #[arg(long, allow_hyphen_values = true)]
     friction: Option<f64>,
-    /// Simulated time to show, s.
-    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
-    time: f64,
-    /// Output PNG.
+    /// Also show the sliding model with these friction coefficients (comma-separated).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    compare_friction: Vec<f64>,
+    /// Simulated time to show in a picture, s.
+    #[arg(long, allow_hyphen_values = true)]
+    time: Option<f64>,
+    /// A replay (--out .mp4 or .gif): first frame, simulated s.
+    #[arg(long, allow_hyphen_values = true)]
+    from: Option<f64>,
+    /// A replay: last frame, simulated s (default: the end of the record).
+    #[arg(long, allow_hyphen_values = true)]
+    to: Option<f64>,
+    /// A replay: frames per simulated second (played back in real time).
+    #[arg(long, allow_hyphen_values = true)]
+    fps: Option<f64>,
+    /// Output: a PNG picture, or a replay (.mp4 through ffmpeg, else .gif).
     #[arg(long, default_value = "frame.png")]
     out: PathBuf,
+    /// Also write the plots' data at the time shown: DIR/series.csv and DIR/spectrum.csv.
+    #[arg(long)]
+    data: Option<PathBuf>,
     /// Width, pixels.
-    #[arg(long, default_value_t = 1280)]
-    width: u32,
+    #[arg(long)]
+    width: Option<u32>,
     /// Height, pixels.
-    #[arg(long, default_value_t = 720)]
-    height: u32,
-    /// Deformation exaggeration factor.
-    #[arg(long, default_value_t = 50.0, allow_hyphen_values = true)]
-    exaggeration: f32,
+    #[arg(long)]
+    height: Option<u32>,
+    /// Deformation exaggeration factor (default: automatic, as in the window).
+    #[arg(long, allow_hyphen_values = true)]
+    exaggeration: Option<f32>,
     /// Only the sliding model (no fixed-base panel beside it).
     #[arg(long)]
     single: bool,
+    /// No joint close-ups under the models.
+    #[arg(long)]
+    no_close_ups: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -353,6 +375,7 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
         alpha: args.alpha,
         friction: args.friction,
         fixed_base: args.fixed_base,
+        pga_g: None,
         ground: args.ground.map(|g| match g {
             GroundArg::Prescribed => GroundKind::Prescribed,
             GroundArg::LargeMass => GroundKind::LargeMass,
@@ -667,26 +690,28 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     ))
 }
 
-/// The picture flags of `render` in their ranges (a 10⁵ × 10⁵ picture is 40 GB).
+/// The picture flags of `render` in their ranges (a 10⁵ × 10⁵ picture is 40 GB), checked
+/// before anything is run (and in a build without the window too).
 fn check_picture(args: &RenderArgs) -> Result<()> {
-    use slidebase::limits::MAX_IMAGE_SIDE;
+    use slidebase::limits::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
-        if !(1..=MAX_IMAGE_SIDE).contains(&v) {
-            bail!("invalid {flag}: {v} pixels; give 1 to {MAX_IMAGE_SIDE}");
+        if let Some(v) = v
+            && !(MIN_IMAGE_SIDE..=MAX_IMAGE_SIDE).contains(&v)
+        {
+            bail!("invalid {flag}: {v} pixels; give {MIN_IMAGE_SIDE} to {MAX_IMAGE_SIDE}");
         }
     }
-    if !(args.exaggeration.is_finite() && args.exaggeration >= 0.0) {
-        bail!(
-            "invalid --exaggeration: {}; give a finite factor >= 0",
-            args.exaggeration
-        );
+    if let Some(f) = args.exaggeration
+        && !(f.is_finite() && f > 0.0)
+    {
+        bail!("invalid --exaggeration: {f}; give a finite factor > 0 (1: true scale)");
     }
     Ok(())
 }
 
 #[cfg(feature = "gui")]
 fn cmd_render(args: RenderArgs) -> Result<()> {
-    use slidebase::render::offscreen::{PictureOptions, render_run_png};
+    use slidebase::export::{PictureOptions, VideoFormat, render_picture, render_video};
     use slidebase::sim::{Excitation, SimConfig};
     check_picture(&args)?;
     let config = SimConfig {
@@ -694,19 +719,74 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         friction: args.friction,
         excitation: args.record.map_or(Excitation::Scene, Excitation::Record),
         compare_fixed: !args.single,
+        compare_friction: args.compare_friction,
+        pga_g: args.pga,
         ..SimConfig::default()
     };
-    let options = PictureOptions {
-        width: args.width,
-        height: args.height,
-        exaggeration: args.exaggeration,
-        ..PictureOptions::default()
+    let video = VideoFormat::of(&args.out);
+    let default_size = match video {
+        Some(VideoFormat::Gif) => (800, 450),
+        _ => (1280, 720),
     };
-    let info = render_run_png(&config, args.time, &options, &args.out)?;
+    let options = PictureOptions {
+        width: args.width.unwrap_or(default_size.0),
+        height: args.height.unwrap_or(default_size.1),
+        exaggeration: args.exaggeration,
+        close_ups: !args.no_close_ups,
+    };
+    let info = match video {
+        Some(_) => {
+            if args.time.is_some() {
+                bail!(
+                    "--time is for a picture; a replay (--out {}) takes --from, --to and --fps",
+                    args.out.display()
+                );
+            }
+            let to = match args.to {
+                Some(t) => t,
+                None => slidebase::sim::prepare(&config)?.duration,
+            };
+            render_video(
+                &config,
+                args.from.unwrap_or(0.0),
+                to,
+                args.fps.unwrap_or(25.0),
+                &options,
+                &args.out,
+                args.data.as_deref(),
+            )?
+        }
+        None => {
+            for (flag, given) in [
+                ("--from", args.from.is_some()),
+                ("--to", args.to.is_some()),
+                ("--fps", args.fps.is_some()),
+            ] {
+                if given {
+                    bail!(
+                        "{flag} is for a replay (--out replay.mp4 or replay.gif), not for a picture ({})",
+                        args.out.display()
+                    );
+                }
+            }
+            render_picture(
+                &config,
+                args.time.unwrap_or(5.0),
+                &options,
+                &args.out,
+                args.data.as_deref(),
+            )?
+        }
+    };
+    if let Some(note) = &info.note {
+        eprintln!("note: {note}");
+    }
+    let files: Vec<String> = info.files.iter().map(|f| f.display().to_string()).collect();
     out(&format!(
-        "wrote {} (t = {:.3} s, {}; simulated in {:.2} s, rendered in {:.3} s)",
-        args.out.display(),
-        info.time,
+        "wrote {} ({} frame{}, {}; simulated in {:.2} s, rendered in {:.2} s)",
+        files.join(", "),
+        info.frames,
+        if info.frames == 1 { "" } else { "s" },
         info.adapter,
         info.simulate_s,
         info.render_s

@@ -22,6 +22,8 @@ pub mod analytic;
 pub mod app;
 pub mod dda;
 pub mod error;
+#[cfg(feature = "gui")]
+pub mod export;
 pub mod ground_motion;
 pub mod headless;
 pub mod limits;

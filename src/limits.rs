@@ -102,6 +102,10 @@ pub const MAX_JOBS: usize = 1_024;
 /// Width and height of a rendered picture, pixels.
 pub const MAX_IMAGE_SIDE: u32 = 8_192;
 
+/// Smallest width and height of a rendered picture, pixels (room for the titles and the
+/// legend).
+pub const MIN_IMAGE_SIDE: u32 = 64;
+
 /// Reads a text file of at most `max_bytes`, refusing what is not a regular file (a pipe,
 /// FIFO, device or folder could be endless or block forever). `what` names the kind of
 /// file in the messages. Errors name the file.

@@ -8,8 +8,8 @@
 #![cfg(feature = "gui")]
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use slidebase::render::offscreen::{FORMAT, Gpu, render_rgba, side_by_side};
-use slidebase::render::{ColorBy, Layers, Renderer, SceneView};
+use slidebase::render::offscreen::{FORMAT, Gpu, render_rgba};
+use slidebase::render::{ColorBy, Layers, PanelView, Renderer, SceneView, ViewBox};
 use slidebase::sim::{BlockFrame, ContactFrame, ModelFrame, Probes};
 
 fn gpu() -> Option<Gpu> {
@@ -48,16 +48,25 @@ fn frame(slip: f64) -> ModelFrame {
         contacts: vec![
             ContactFrame {
                 point: [-1.0, 0.0],
+                rigid: [-1.0, 0.0],
                 tangent: [-1.0, 0.0],
                 normal_force: 1.0,
                 state: 1,
             },
             ContactFrame {
                 point: [1.0, 0.0],
+                rigid: [1.0, 0.0],
                 tangent: [-1.0, 0.0],
                 normal_force: 1.0,
                 state: 2,
             },
+        ],
+        base: 1,
+        base_start: vec![
+            [-1.0 - slip as f32, 0.0],
+            [1.0 - slip as f32, 0.0],
+            [1.0 - slip as f32, 1.0],
+            [-1.0 - slip as f32, 1.0],
         ],
         bolts: vec![],
         connections: vec![],
@@ -83,17 +92,18 @@ impl Image {
 /// Renders one panel of `frame` at 400×300 with the world window [half 4 m, y −1…3 m]:
 /// 100 px per metre, x = 0 at column 200, y = 0 at row 225.
 fn render(gpu: &Gpu, f: &ModelFrame, layers: Layers) -> Image {
-    let frames = vec![f.clone()];
-    let mut panels = side_by_side(
-        &frames,
-        &[[2.0, -1.0, 2.0]],
-        &[[0.0, f.probes.slip as f32]],
-        400,
-        300,
-    );
-    panels[0].window = [2.0, -0.75, 2.25];
+    let slip = f.probes.slip as f32;
     let view = SceneView {
-        panels,
+        panels: vec![PanelView {
+            frame: f,
+            rect: [0.0, 0.0, 400.0, 300.0],
+            view: ViewBox {
+                centre: [0.0, 0.75],
+                metres_per_pixel: 0.01,
+            },
+            slip_range: [slip.min(0.0), slip.max(0.0)],
+            close_up: false,
+        }],
         exaggeration: 1.0,
         color_by: ColorBy::Material,
         color_max: 1.0,
@@ -173,20 +183,21 @@ fn slip_arrow_points_the_way_the_base_slipped() {
             })
             .count()
     };
-    // Slipped +0.8 m: the mark where the base started is 0.8 m to the left of the base's
-    // centre (the camera follows the base), and the arrow runs from it to the centre.
+    // Slipped +0.8 m: the mark where the base's left end (x = −1 m, column 100) started is
+    // 0.8 m further left (column 20), and the arrow runs from it to the base.
     let right = render(&gpu, &frame(0.8), layers);
     assert!(
-        red(&right, 125, 195) > 40,
-        "arrow to the left of centre when slip > 0"
+        red(&right, 25, 95) > 40,
+        "arrow left of the base when slip > 0"
     );
     assert!(red(&right, 210, 300) < 5, "nothing to the right");
+    // Slipped −0.8 m: it started 0.8 m to the right (column 180); the arrow points left.
     let left = render(&gpu, &frame(-0.8), layers);
     assert!(
-        red(&left, 210, 280) > 40,
-        "arrow to the right of centre when slip < 0"
+        red(&left, 105, 175) > 40,
+        "arrow right of the base's end when slip < 0"
     );
-    assert!(red(&left, 100, 190) < 5);
+    assert!(red(&left, 20, 95) < 5);
 }
 
 #[test]
@@ -233,12 +244,12 @@ fn two_block_scene_matches_the_reference_image() {
         scene: "two-block".into(),
         ..Default::default()
     };
-    let options = slidebase::render::offscreen::PictureOptions {
+    let options = slidebase::export::PictureOptions {
         width: 640,
         height: 360,
         ..Default::default()
     };
-    slidebase::render::offscreen::render_run_png(&config, 1.5, &options, &path).unwrap();
+    slidebase::export::render_picture(&config, 1.5, &options, &path, None).unwrap();
     let reference = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data/reference/two_block_t1.5.png");
     if std::env::var_os("SLIDEBASE_UPDATE_REFERENCE").is_some() {

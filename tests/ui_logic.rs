@@ -1,46 +1,16 @@
-//! The visualizer's UI logic, driven through egui with synthetic input and no window:
-//! moving the friction slider restarts the simulation with the new value, scrubbing the
-//! timeline shows the state of that time, and a bad record file shows an error.
+//! The visualizer's UI, driven like a person would through egui_kittest (no window, no
+//! GPU): widgets found by their labels, clicked, dragged and typed into. Each test names
+//! the behaviour it protects; several are regressions of issue 12's findings.
 
 #![cfg(feature = "gui")]
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use slidebase::sim::{FrameSet, SimCommand, SimMessage};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable as _;
+use slidebase::sim::{FrameSet, SimCommand, SimConfig, SimMessage};
 use slidebase::ui::AppState;
 
-/// Runs one UI pass with these input events.
-fn pass(ctx: &egui::Context, state: &mut AppState, events: Vec<egui::Event>) {
-    let input = egui::RawInput {
-        screen_rect: Some(egui::Rect::from_min_size(
-            egui::Pos2::ZERO,
-            egui::vec2(1600.0, 900.0),
-        )),
-        events,
-        ..Default::default()
-    };
-    let mut output = ctx.run_ui(input, |ui| {
-        state.ui(ui);
-    });
-    // No GPU here: the font atlas updates are dropped on purpose.
-    output.textures_delta.clear();
-}
-
-/// A press-drag-release from `a` to `b`.
-fn drag(ctx: &egui::Context, state: &mut AppState, a: egui::Pos2, b: egui::Pos2) {
-    let button = |pos, pressed| egui::Event::PointerButton {
-        pos,
-        button: egui::PointerButton::Primary,
-        pressed,
-        modifiers: Default::default(),
-    };
-    pass(ctx, state, vec![egui::Event::PointerMoved(a)]);
-    pass(ctx, state, vec![button(a, true)]);
-    pass(ctx, state, vec![egui::Event::PointerMoved(b)]);
-    pass(ctx, state, vec![button(b, false)]);
-    pass(ctx, state, vec![]);
-}
-
-fn runs(commands: &[SimCommand]) -> Vec<slidebase::sim::SimConfig> {
+fn runs(commands: &[SimCommand]) -> Vec<SimConfig> {
     commands
         .iter()
         .filter_map(|c| match c {
@@ -50,33 +20,19 @@ fn runs(commands: &[SimCommand]) -> Vec<slidebase::sim::SimConfig> {
         .collect()
 }
 
-#[test]
-fn moving_the_friction_slider_restarts_with_the_new_value() {
-    let ctx = egui::Context::default();
-    let mut state = AppState::default();
-    let first = runs(&state.take_commands());
-    assert_eq!(first.len(), 1, "the default scene starts at once");
-    assert_eq!(first[0].friction, Some(0.01));
-    pass(&ctx, &mut state, vec![]);
-    let rect = state.widget_rects["friction"];
-    // Drag the slider's handle from its position to near the right end.
-    let y = rect.center().y;
-    let slider_left = rect.left() + 5.0;
-    drag(
-        &ctx,
-        &mut state,
-        egui::pos2(slider_left, y),
-        egui::pos2(slider_left + 80.0, y),
-    );
-    let restarts = runs(&state.take_commands());
-    assert!(!restarts.is_empty(), "moving the slider restarts the run");
-    let f = restarts.last().unwrap().friction.unwrap();
-    assert!((f - 0.01).abs() > 1e-6 && f > 0.0, "new friction {f}");
-    assert_eq!(f, state.controls.friction);
+/// A harness around the whole UI at a window size.
+fn harness(state: AppState, w: f32, h: f32) -> Harness<'static, AppState> {
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(w, h))
+        .build_ui_state(|ui, state: &mut AppState| state.ui(ui), state);
+    h.run_steps(2);
+    h
 }
 
-fn synthetic_run(state: &mut AppState) {
-    let run = slidebase::sim::prepare(&slidebase::sim::SimConfig {
+/// Messages of a synthetic run of the two-block scene: frames every 10 ms up to
+/// `duration`, each marked by its time in the slip probe, full-rate samples every 5 ms.
+fn synthetic(generation: u64, duration: f64, upto: f64) -> Vec<SimMessage> {
+    let run = slidebase::sim::prepare(&SimConfig {
         scene: "two-block".into(),
         duration: Some(1.0),
         ..Default::default()
@@ -95,96 +51,268 @@ fn synthetic_run(state: &mut AppState) {
             })
             .collect(),
     };
-    state.ingest(SimMessage::Started {
-        generation: 1,
-        config: Box::default(),
-        duration: 1.0,
-        labels: vec!["sliding base".into(), "fixed base".into()],
-        exact: None,
-        first: Box::new(frame(0.0)),
+    let n = (upto / 0.01).round() as usize;
+    let mut samples = vec![slidebase::sim::Samples::default(); run.models.len()];
+    for s in &mut samples {
+        for k in 0..=2 * n {
+            let t = k as f64 * 0.005;
+            s.time.push(t);
+            s.ground_accel.push((std::f64::consts::TAU * t).sin());
+            s.base_accel.push(0.5 * (std::f64::consts::TAU * t).sin());
+            s.roof_accel.push(0.4 * (std::f64::consts::TAU * t).sin());
+            s.slip.push(0.1 * t);
+            s.drift.push(0.01 * (std::f64::consts::TAU * t).sin());
+        }
+    }
+    let mut msgs = vec![
+        SimMessage::Started {
+            generation,
+            config: Box::default(),
+            duration,
+            labels: vec!["sliding base, ρ = 0.1".into(), "fixed base".into()],
+            motion: Box::default(),
+            exact: None,
+            first: Box::new(frame(0.0)),
+        },
+        SimMessage::Frames {
+            generation,
+            frames: (1..=n).map(|k| frame(k as f64 * 0.01)).collect(),
+            samples,
+            speed: 10.0,
+            extract_us: 1.0,
+        },
+    ];
+    if upto >= duration - 1e-9 {
+        msgs.push(SimMessage::Finished {
+            generation,
+            wall_time_s: 0.1,
+        });
+    }
+    msgs
+}
+
+fn with_run(duration: f64) -> AppState {
+    let mut state = AppState::default();
+    state.take_commands();
+    for m in synthetic(1, duration, duration) {
+        state.ingest(m);
+    }
+    state
+}
+
+fn click_at(h: &Harness<'_, AppState>, pos: egui::Pos2) {
+    h.event(egui::Event::PointerMoved(pos));
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        });
+    }
+}
+
+/// Issue 12, finding 4: typing one letter in the path field restarted the run and sent a
+/// paused replay at 9.84 s back to 0.
+#[test]
+fn typing_a_path_restarts_nothing() {
+    let mut state = with_run(12.0);
+    state.seek(9.84);
+    let mut h = harness(state, 1600.0, 900.0);
+    let field = h.state().widget_rects["path"];
+    click_at(&h, field.center());
+    h.run_steps(2);
+    for ch in ["q", "u", "a", "k", "e", ".", "a", "t", "2"] {
+        h.event(egui::Event::Text(ch.into()));
+        h.step();
+    }
+    let state = h.state_mut();
+    assert_eq!(
+        state.path_input, "quake.at2",
+        "the text went into the field"
+    );
+    assert!(
+        runs(&state.take_commands()).is_empty(),
+        "typing starts no run"
+    );
+    assert!(
+        (state.play_time - 9.84).abs() < 1e-9,
+        "cursor at {}",
+        state.play_time
+    );
+    assert!(!state.playing);
+}
+
+/// Issue 12, finding 10: every parameter change rewound to t = 0. Now the new run is
+/// shown at the same time as soon as it has been computed that far.
+#[test]
+fn a_parameter_change_keeps_the_time_cursor() {
+    let mut state = with_run(2.0);
+    state.seek(1.5);
+    let mut h = harness(state, 1600.0, 900.0);
+    // Drag the friction slider's handle to the right.
+    let r = h.state().widget_rects["friction"];
+    let y = r.center().y;
+    let x0 = r.left() + 0.3 * r.width() * 0.6;
+    h.event(egui::Event::PointerMoved(egui::pos2(x0, y)));
+    h.event(egui::Event::PointerButton {
+        pos: egui::pos2(x0, y),
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: Default::default(),
     });
+    h.step();
+    h.event(egui::Event::PointerMoved(egui::pos2(x0 + 60.0, y)));
+    h.step();
+    h.event(egui::Event::PointerButton {
+        pos: egui::pos2(x0 + 60.0, y),
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: Default::default(),
+    });
+    h.run_steps(2);
+    let state = h.state_mut();
+    let restarts = runs(&state.take_commands());
+    assert!(!restarts.is_empty(), "moving the slider restarts the run");
+    let f = restarts.last().unwrap().friction.unwrap();
+    assert!((f - 0.01).abs() > 1e-4, "new friction {f}");
+    assert_eq!(state.resume_at, Some(1.5));
+    // The new run arrives, first computed to 0.5 s only: the cursor waits at 1.5 s.
+    let mut msgs = synthetic(2, 2.0, 0.5);
+    state.ingest(msgs.remove(0));
+    state.ingest(msgs.remove(0));
+    state.advance(0.1);
+    assert!(
+        (state.play_time - 1.5).abs() < 1e-9,
+        "cursor {}",
+        state.play_time
+    );
+    assert_eq!(state.resume_at, Some(1.5));
+    // Once it has been computed past 1.5 s, the frame of 1.5 s is shown.
     state.ingest(SimMessage::Frames {
-        generation: 1,
-        frames: (1..=100).map(|k| frame(k as f64 * 0.01)).collect(),
-        speed: 10.0,
-        extract_us: 1.0,
-    });
-    state.ingest(SimMessage::Finished {
-        generation: 1,
-        wall_time_s: 0.1,
-    });
-    // Frames of an older run are ignored.
-    state.ingest(SimMessage::Frames {
-        generation: 0,
-        frames: vec![frame(5.0)],
+        generation: 2,
+        frames: synthetic(2, 2.0, 2.0)
+            .into_iter()
+            .find_map(|m| match m {
+                SimMessage::Frames { frames, .. } => Some(frames[50..].to_vec()),
+                _ => None,
+            })
+            .unwrap(),
+        samples: vec![Default::default(); 2],
         speed: 1.0,
         extract_us: 1.0,
     });
+    assert_eq!(state.resume_at, None);
+    let shown = state.current().unwrap();
+    assert!((shown.time - 1.5).abs() < 1e-9, "shows {}", shown.time);
 }
 
+/// Issue 12, finding 7: ←/→ merged when pressed quickly, Shift did nothing, play at the end
+/// did nothing with loop off, a quick click on the rail was ignored.
 #[test]
-fn scrubbing_shows_the_state_of_that_time() {
-    let ctx = egui::Context::default();
-    let mut state = AppState::default();
-    state.take_commands();
-    synthetic_run(&mut state);
-    assert_eq!(state.timeline.frames.len(), 101);
-    pass(&ctx, &mut state, vec![]);
-    let rect = state.widget_rects["time"];
-    // Drag the time slider to about 60 % of its length.
-    let y = rect.center().y;
-    let track = rect.width() * 0.55; // the slider's track; its value box follows
-    drag(
-        &ctx,
-        &mut state,
-        egui::pos2(rect.left() + 4.0, y),
-        egui::pos2(rect.left() + 0.6 * track, y),
-    );
-    assert!(!state.playing, "scrubbing pauses playback");
-    let t = state.play_time;
-    assert!(t > 0.1 && t < 1.0, "scrubbed to {t}");
-    let shown = state.current().unwrap();
+fn keys_step_frames_and_seconds_and_the_rail_takes_a_click() {
+    let mut state = with_run(3.0);
+    state.seek(1.0);
+    let mut h = harness(state, 1600.0, 900.0);
+    // Two presses within one frame are two steps.
+    h.key_press(egui::Key::ArrowRight);
+    h.key_press(egui::Key::ArrowRight);
+    h.step();
     assert!(
-        (shown.time - t).abs() <= 0.01 + 1e-9,
-        "frame {} for cursor {t}",
-        shown.time
+        (h.state().play_time - 1.02).abs() < 1e-9,
+        "{}",
+        h.state().play_time
     );
+    h.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::ArrowRight);
+    h.step();
     assert!(
-        (shown.models[0].probes.slip - shown.time).abs() < 1e-12,
-        "the frame of that time"
+        (h.state().play_time - 2.02).abs() < 1e-9,
+        "{}",
+        h.state().play_time
     );
-    // Keyboard steps move one frame.
-    let before = state.current().unwrap().time;
-    state.step_frames(1);
-    assert!((state.current().unwrap().time - before - 0.01).abs() < 1e-9);
-    state.step_frames(-3);
-    assert!((state.current().unwrap().time - before + 0.02).abs() < 1e-9);
+    h.key_press_modifiers(egui::Modifiers::SHIFT, egui::Key::ArrowLeft);
+    h.key_press(egui::Key::ArrowLeft);
+    h.step();
+    assert!(
+        (h.state().play_time - 1.01).abs() < 1e-9,
+        "{}",
+        h.state().play_time
+    );
+    h.key_press(egui::Key::End);
+    h.step();
+    assert!((h.state().play_time - 3.0).abs() < 1e-9);
+    // Play at the end (loop off) starts again.
+    h.state_mut().looping = false;
+    h.get_by_label("▶ play").click();
+    h.step();
+    assert!(h.state().playing && h.state().play_time < 1e-9, "restarted");
+    // A quick click on the rail, three quarters along, moves the cursor there.
+    let rail = h.state().widget_rects["time"];
+    click_at(
+        &h,
+        egui::pos2(rail.left() + 0.75 * rail.width(), rail.center().y),
+    );
+    h.step();
+    assert!(!h.state().playing);
+    let t = h.state().play_time;
+    assert!((t - 2.25).abs() < 0.02, "clicked to {t}");
+    // The rail uses the width: more than half of a 1024-wide window.
+    let h2 = harness(with_run(3.0), 1024.0, 600.0);
+    assert!(h2.state().widget_rects["time"].width() > 450.0);
+}
+
+/// Space plays and pauses, H shows the shortcuts, F fits, Ctrl+Q asks to quit.
+#[test]
+fn shortcuts_work_and_are_listed() {
+    let mut h = harness(with_run(1.0), 1600.0, 900.0);
+    h.state_mut().playing = true;
+    h.key_press(egui::Key::Space);
+    h.step();
+    assert!(!h.state().playing);
+    h.key_press(egui::Key::H);
+    h.run_steps(2);
+    assert!(h.state().view.show_help);
+    h.get_by_label("one second back / on");
+    h.state_mut().view.camera.zoom = 3.0;
+    h.key_press(egui::Key::F);
+    h.step();
+    assert_eq!(h.state().view.camera.zoom, 1.0);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    h.step();
+    assert!(
+        h.state_mut()
+            .take_requests()
+            .contains(&slidebase::ui::ShellRequest::Quit)
+    );
+}
+
+/// A lecture preset sets up its comparison: three friction coefficients side by side.
+#[test]
+fn the_friction_preset_runs_three_frictions() {
+    let mut h = harness(with_run(1.0), 1600.0, 900.0);
+    h.get_by_value("lecture presets…").click();
+    h.run_steps(2);
+    h.get_by_label("What friction does: ρ = 0.01 / 0.05 / 0.2")
+        .click();
+    h.run_steps(2);
+    let r = runs(&h.state_mut().take_commands());
+    let last = r.last().expect("the preset starts a run");
+    assert_eq!(last.friction, Some(0.01));
+    assert_eq!(last.compare_friction, vec![0.05, 0.2]);
+    assert!(!last.compare_fixed);
 }
 
 #[test]
 fn loading_a_bad_record_file_shows_an_error() {
-    let ctx = egui::Context::default();
-    let mut state = AppState::default();
-    state.take_commands();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("quake.csv");
     std::fs::write(&path, "0,0\n0.01,0.2\n0.02,nan\n").unwrap();
-    state.controls.path_input = path.display().to_string();
-    pass(&ctx, &mut state, vec![]);
-    let rect = state.widget_rects["load"];
-    let button = |pressed| egui::Event::PointerButton {
-        pos: rect.center(),
-        button: egui::PointerButton::Primary,
-        pressed,
-        modifiers: Default::default(),
-    };
-    pass(
-        &ctx,
-        &mut state,
-        vec![egui::Event::PointerMoved(rect.center())],
-    );
-    pass(&ctx, &mut state, vec![button(true)]);
-    pass(&ctx, &mut state, vec![button(false)]);
+    let mut state = with_run(1.0);
+    state.path_input = path.display().to_string();
+    let mut h = harness(state, 1600.0, 900.0);
+    h.get_by_label("load").click();
+    h.run_steps(2);
+    let state = h.state_mut();
     let error = state.error.clone().expect("an error is shown");
     assert!(
         error.contains("quake.csv:3") && error.contains("not finite"),
@@ -197,26 +325,71 @@ fn loading_a_bad_record_file_shows_an_error() {
     // A good one restarts the run with it.
     std::fs::write(&path, "0,0\n0.01,0.2\n0.02,0.1\n").unwrap();
     state.load_path();
-    let r = runs(&state.take_commands());
-    assert_eq!(r.len(), 1);
+    assert_eq!(runs(&state.take_commands()).len(), 1);
     assert!(state.error.is_none());
 }
 
-/// Regression: the default view stopped itself at t ≈ 0.1 s. The time slider shows two
-/// decimals and rounded the playing time to them, which egui reports as a change of the
-/// slider; that was taken for the user scrubbing, which pauses playback.
+/// Regression: the default view stopped itself at t ≈ 0.1 s (the old slider rounded the
+/// playing time and that was taken for the user scrubbing).
 #[test]
 fn playback_runs_on_by_itself() {
-    let ctx = egui::Context::default();
-    let mut state = AppState::default();
-    state.take_commands();
-    synthetic_run(&mut state);
-    assert!(state.playing, "the visualizer opens playing");
+    let mut h = harness(with_run(1.0), 1600.0, 900.0);
+    h.state_mut().playing = true;
+    h.state_mut().play_time = 0.0;
     for _ in 0..30 {
-        state.advance(0.0137);
-        pass(&ctx, &mut state, vec![]);
+        h.state_mut().advance(0.0137);
+        h.step();
     }
-    assert!(state.playing, "nothing but the user pauses playback");
-    let t = state.play_time;
+    assert!(h.state().playing, "nothing but the user pauses playback");
+    let t = h.state().play_time;
     assert!((t - 30.0 * 0.0137).abs() < 1e-9, "played to {t}");
+}
+
+/// "plot data (CSV)" writes the series and spectra the plots show, well formed.
+#[test]
+fn plot_data_export_writes_well_formed_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut state = with_run(2.0);
+    state.export_dir = dir.path().display().to_string();
+    state.seek(1.0);
+    let mut h = harness(state, 1600.0, 900.0);
+    h.get_by_label("💾 plot data (CSV)").click();
+    h.run_steps(2);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    let series = std::fs::read_to_string(dir.path().join("series.csv")).unwrap();
+    let mut lines = series.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("time_s,ground_accel_g,"), "{header}");
+    assert!(
+        header.contains("\"roof_accel_g (sliding base, ρ = 0.1)\""),
+        "{header}"
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // Everything computed (2 s) at the samples' 5 ms: 401 rows of 2 + 2 × 4 columns.
+    assert_eq!(rows.len(), 401);
+    assert!(
+        rows.iter()
+            .all(|r| r.len() == 10 && r.iter().all(|v| v.is_finite()))
+    );
+    assert!((rows[400][0] - 2.0).abs() < 1e-9);
+    let mut spectrum = csv::Reader::from_path(dir.path().join("spectrum.csv")).unwrap();
+    let names: Vec<String> = spectrum
+        .headers()
+        .unwrap()
+        .iter()
+        .map(String::from)
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "frequency_hz",
+            "ground",
+            "base, sliding base, ρ = 0.1",
+            "base, fixed base"
+        ]
+    );
+    let rows: Vec<csv::StringRecord> = spectrum.records().map(Result::unwrap).collect();
+    assert!(rows.len() > 10 && rows.iter().all(|r| r.len() == 4));
 }

@@ -89,6 +89,22 @@ pub struct EnergyBalance {
     pub friction_dissipated: f64,
     /// input − (kinetic + strain + dissipated): zero up to quadrature rounding.
     pub residual: f64,
+    /// The energy that has passed through the model: the largest stored (kinetic +
+    /// strain) energy of the run plus the friction dissipated, or |input| if larger.
+    /// The residual is relative to it, so a run in which nothing slides (input work ~0,
+    /// all of it given back) still has a meaningful relative residual.
+    pub scale: f64,
+}
+
+impl EnergyBalance {
+    /// The residual relative to [`EnergyBalance::scale`] (0 for a model at rest).
+    pub fn residual_relative(&self) -> f64 {
+        if self.scale > 0.0 {
+            self.residual / self.scale
+        } else {
+            0.0
+        }
+    }
 }
 
 /// The exact response.
@@ -525,6 +541,7 @@ pub fn simulate(
     };
     peaks.peaks.ground_accel = ground.peak_accel(duration);
     let mut energy = EnergyBalance::default();
+    let mut most_stored = 0.0_f64;
     let mut next_output = 0.0;
     let mut output_index = 0u64;
     let record_output = |res: &mut ExactResult, s: &Snapshot| {
@@ -683,25 +700,15 @@ pub fn simulate(
             }
         }
         state = end;
+        let (kinetic, strain) = stored_energy(b, ground, &state);
+        most_stored = most_stored.max(kinetic + strain);
     }
-    // Final energies.
-    let v0 = ground.velocity(state.t);
-    let vb = v0 + state.v_s;
-    let mut kinetic = 0.5 * b.raft_mass * vb * vb;
-    let mut strain = 0.0;
-    for i in 0..n {
-        let v = vb + state.v_r[i];
-        kinetic += 0.5 * b.storey_masses[i] * v * v;
-        let du = if i == 0 {
-            state.u_r[0]
-        } else {
-            state.u_r[i] - state.u_r[i - 1]
-        };
-        strain += 0.5 * b.storey_stiffnesses[i] * du * du;
-    }
+    let (kinetic, strain) = stored_energy(b, ground, &state);
     energy.kinetic = kinetic;
     energy.strain = strain;
     energy.residual = energy.input_work - kinetic - strain - energy.friction_dissipated;
+    energy.scale = (most_stored.max(kinetic + strain) + energy.friction_dissipated)
+        .max(energy.input_work.abs());
     result.energy = energy;
     result.peaks = peaks.peaks;
     result.residual_slip = state.u_s;
@@ -751,4 +758,22 @@ fn track_extrema(
         let t = solver.root(ta, sign * da, tb, sign * db, &f);
         offer_peaks(solver, peaks, &at(t));
     }
+}
+
+/// Absolute kinetic energy and storey spring energy of a state.
+fn stored_energy(b: &ShearBuilding, ground: &GroundMotion, state: &Snapshot) -> (f64, f64) {
+    let vb = ground.velocity(state.t) + state.v_s;
+    let mut kinetic = 0.5 * b.raft_mass * vb * vb;
+    let mut strain = 0.0;
+    for i in 0..b.storey_masses.len() {
+        let v = vb + state.v_r[i];
+        kinetic += 0.5 * b.storey_masses[i] * v * v;
+        let du = if i == 0 {
+            state.u_r[0]
+        } else {
+            state.u_r[i] - state.u_r[i - 1]
+        };
+        strain += 0.5 * b.storey_stiffnesses[i] * du * du;
+    }
+    (kinetic, strain)
 }

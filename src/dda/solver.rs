@@ -133,7 +133,6 @@ impl NodeMotion for StepMotion<'_> {
 pub struct Dda {
     blocks: Vec<Block>,
     ground: usize,
-    ground_kind: GroundKind,
     dofs: DofMap,
     /// Which blocks can couple in the system matrix (fixed for the run).
     pattern: Arc<BlockPattern>,
@@ -393,7 +392,6 @@ impl Dda {
         let mut model = Self {
             blocks,
             ground,
-            ground_kind: scene.ground.kind,
             dofs,
             pattern,
             linear,

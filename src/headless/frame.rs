@@ -494,11 +494,7 @@ fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
     for (&t, &a) in r.time.iter().zip(&r.raft_accel) {
         series.push(t, a);
     }
-    let residual = if r.energy.input_work != 0.0 {
-        r.energy.residual / r.energy.input_work
-    } else {
-        0.0
-    };
+    let residual = r.energy.residual_relative();
     let keep = setup.history.stride() > 0;
     let run = simulate::exact_model_run(&r, motion, keep, 1.0, residual, start);
     let summary = summarise(setup, ModelKind::MassSpring, &run, Some(series))?;

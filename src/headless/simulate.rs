@@ -175,13 +175,7 @@ pub fn run_exact(
         output_dt,
         &ExactOptions::default(),
     )?;
-    // The model has total mass 1: energies scale with the scene's M + m.
-    let e = r.energy;
-    let residual = if e.input_work.abs() > 0.0 {
-        e.residual / e.input_work.abs()
-    } else {
-        0.0
-    };
+    let residual = r.energy.residual_relative();
     Ok(exact_model_run(
         &r, motion, true, total_mass, residual, start,
     ))

@@ -63,12 +63,24 @@ impl History {
         let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
         let mut w = std::io::BufWriter::new(file);
         let io = |e| Error::io(path, e);
-        writeln!(w, "{}", self.names.join(",")).map_err(io)?;
+        // Names with a comma or a quote are quoted (RFC 4180).
+        let names: Vec<String> = self
+            .names
+            .iter()
+            .map(|n| {
+                if n.contains([',', '"']) {
+                    format!("\"{}\"", n.replace('"', "\"\""))
+                } else {
+                    n.clone()
+                }
+            })
+            .collect();
+        writeln!(w, "{}", names.join(",")).map_err(io)?;
         for row in 0..self.len() {
             let line: Vec<String> = self
                 .columns
                 .iter()
-                .map(|c| format!("{:.9e}", c[row]))
+                .map(|c| format!("{:.9e}", c.get(row).copied().unwrap_or(f64::NAN)))
                 .collect();
             writeln!(w, "{}", line.join(",")).map_err(io)?;
         }

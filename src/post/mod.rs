@@ -6,3 +6,33 @@ pub mod output;
 pub mod plot;
 pub mod spectrum;
 pub mod sweep;
+
+/// A number for people: three significant digits, no trailing zeros (0.01, 0.2, 0.0123,
+/// 12.3, 1500).
+pub fn format_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (2 - x.abs().log10().floor() as i64).max(0) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn numbers_for_people() {
+        use super::format_number as f;
+        assert_eq!(f(0.01), "0.01");
+        assert_eq!(f(0.2), "0.2");
+        assert_eq!(f(0.0123456), "0.0123");
+        assert_eq!(f(12.345), "12.3");
+        assert_eq!(f(1500.0), "1500");
+        assert_eq!(f(-0.05), "-0.05");
+        assert_eq!(f(0.0), "0");
+    }
+}

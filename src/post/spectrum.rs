@@ -65,6 +65,39 @@ pub fn resample_uniform(t: &[f64], y: &[f64], dt: f64) -> Result<Vec<f64>> {
     Ok(out)
 }
 
+/// The Fourier amplitude spectrum of a history sampled at increasing times `t` (not
+/// necessarily evenly), resampled onto a uniform grid of step `dt` first.
+pub fn uniform_spectrum(t: &[f64], y: &[f64], dt: f64) -> Result<Spectrum> {
+    fourier_amplitude(&resample_uniform(t, y, dt)?, dt)
+}
+
+/// Linear interpolation of a history (`t` increasing) at the times `at` (held constant
+/// outside its range; NaN if it is empty).
+pub fn interpolate(t: &[f64], y: &[f64], at: &[f64]) -> Vec<f64> {
+    let n = t.len().min(y.len());
+    at.iter()
+        .map(|&x| {
+            if n == 0 {
+                return f64::NAN;
+            }
+            let k = t[..n].partition_point(|&s| s < x);
+            if k == 0 {
+                return y[0];
+            }
+            if k >= n {
+                return y[n - 1];
+            }
+            let span = t[k] - t[k - 1];
+            let w = if span > 0.0 {
+                (x - t[k - 1]) / span
+            } else {
+                1.0
+            };
+            y[k - 1] + w * (y[k] - y[k - 1])
+        })
+        .collect()
+}
+
 /// [`resample_uniform`] done on the fly: points are pushed as a run produces them and
 /// only the uniform samples are kept, so a spectrum of a long run needs no stored history.
 /// The samples are those `resample_uniform` gives for the same points. Beyond

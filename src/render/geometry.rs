@@ -39,7 +39,8 @@ pub struct Layers {
     pub slip: bool,
     /// Bolts.
     pub bolts: bool,
-    /// Connection elements.
+    /// Outlines of the connection elements (their material is always drawn with the
+    /// blocks: it is what joins a column to a slab).
     pub connections: bool,
     /// Ground and its markings.
     pub ground: bool,
@@ -53,7 +54,8 @@ impl Default for Layers {
             contacts: true,
             slip: true,
             bolts: true,
-            connections: true,
+            // Off by default: triangles drawn inside a joint look like bracing.
+            connections: false,
             ground: true,
         }
     }
@@ -62,6 +64,16 @@ impl Default for Layers {
 /// A rectangle of the target in pixels: x, y (top-left), width, height.
 pub type PixelRect = [f32; 4];
 
+/// The part of the world a panel shows: the world point at the panel's centre and the
+/// scale.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewBox {
+    /// World point at the centre of the panel, m.
+    pub centre: [f32; 2],
+    /// Metres per pixel.
+    pub metres_per_pixel: f32,
+}
+
 /// One model drawn into one rectangle of the target.
 #[derive(Debug, Clone)]
 pub struct PanelView<'a> {
@@ -69,16 +81,19 @@ pub struct PanelView<'a> {
     pub frame: &'a ModelFrame,
     /// Where, in target pixels.
     pub rect: PixelRect,
-    /// World window around the base: (half width, bottom, top), m.
-    pub window: [f32; 3],
+    /// What part of the world.
+    pub view: ViewBox,
     /// Slip range reached so far (min, max), m: the trace on the ground.
     pub slip_range: [f32; 2],
+    /// A close-up of the sliding joint: true scale (no exaggeration), the base's starting
+    /// position drawn as a ghost on the ground and a slip arrow from it.
+    pub close_up: bool,
 }
 
 /// Everything the renderer draws in one frame.
 #[derive(Debug, Clone)]
 pub struct SceneView<'a> {
-    /// Panels (side by side).
+    /// Panels.
     pub panels: Vec<PanelView<'a>>,
     /// Deformation exaggeration factor (1 = true scale).
     pub exaggeration: f32,
@@ -105,6 +120,8 @@ const BOLT: [f32; 4] = [0.15, 0.5, 0.2, 1.0];
 const CONNECTION: [f32; 4] = [0.45, 0.45, 0.5, 1.0];
 const SLIP_ARROW: [f32; 4] = [0.85, 0.1, 0.1, 1.0];
 const TRACE: [f32; 4] = [0.95, 0.75, 0.2, 1.0];
+const GHOST_FILL: [f32; 4] = [0.2, 0.2, 0.25, 0.12];
+const GHOST_LINE: [f32; 4] = [0.15, 0.15, 0.2, 0.9];
 
 /// A colour map from 0 to 1 (a perceptually ordered blue–teal–yellow–red ramp), linear RGB.
 pub fn colormap(t: f32) -> [f32; 4] {
@@ -133,28 +150,28 @@ struct Transform {
     offset: [f32; 2],
     /// World metres per pixel.
     metres_per_pixel: f32,
+    /// The panel in clip space (x0, y0, x1, y1): triangles are clipped to it.
+    clip: [f32; 4],
 }
 
 impl Transform {
-    fn new(panel: &PanelView<'_>, target: [f32; 2], centre_x: f32) -> Self {
+    fn new(panel: &PanelView<'_>, target: [f32; 2]) -> Self {
         let [x, y, w, h] = panel.rect;
-        let [half, bottom, top] = panel.window;
-        // Keep the aspect ratio: metres per pixel from the tighter direction.
-        let mpp = (2.0 * half / w.max(1.0)).max((top - bottom) / h.max(1.0));
-        let world_w = w * mpp;
-        let world_h = h * mpp;
-        let left = centre_x - world_w / 2.0;
-        let low = bottom - (world_h - (top - bottom)) / 2.0;
-        // world → pixel → clip.
+        let mpp = panel.view.metres_per_pixel.max(1e-9);
         let px_per_m = 1.0 / mpp;
+        // World → target pixel: px = x + w/2 + (X − cx)/mpp, py = y + h/2 − (Y − cy)/mpp.
         let sx = px_per_m * 2.0 / target[0];
         let sy = px_per_m * 2.0 / target[1];
-        let ox = (x - left * px_per_m) * 2.0 / target[0] - 1.0;
-        let oy = 1.0 - (y + h + low * px_per_m) * 2.0 / target[1];
+        let ox = (x + 0.5 * w - panel.view.centre[0] * px_per_m) * 2.0 / target[0] - 1.0;
+        let oy = 1.0 - (y + 0.5 * h + panel.view.centre[1] * px_per_m) * 2.0 / target[1];
+        let to_clip = |px: f32, py: f32| [px * 2.0 / target[0] - 1.0, 1.0 - py * 2.0 / target[1]];
+        let a = to_clip(x, y + h);
+        let b = to_clip(x + w, y);
         Self {
             scale: [sx, sy],
             offset: [ox, oy],
             metres_per_pixel: mpp,
+            clip: [a[0], a[1], b[0], b[1]],
         }
     }
 
@@ -166,6 +183,42 @@ impl Transform {
     }
 }
 
+/// Clips a convex polygon (clip space) to an axis-aligned box (Sutherland–Hodgman).
+fn clip_polygon(points: &[[f32; 2]], clip: [f32; 4]) -> Vec<[f32; 2]> {
+    let mut poly = points.to_vec();
+    // (axis, bound, keep values >= bound?)
+    for (axis, bound, keep_above) in [
+        (0, clip[0], true),
+        (0, clip[2], false),
+        (1, clip[1], true),
+        (1, clip[3], false),
+    ] {
+        if poly.is_empty() {
+            break;
+        }
+        let inside = |p: &[f32; 2]| {
+            if keep_above {
+                p[axis] >= bound
+            } else {
+                p[axis] <= bound
+            }
+        };
+        let mut out = Vec::with_capacity(poly.len() + 2);
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            if inside(&a) {
+                out.push(a);
+            }
+            if inside(&a) != inside(&b) {
+                let t = (bound - a[axis]) / (b[axis] - a[axis]);
+                out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            }
+        }
+        poly = out;
+    }
+    poly
+}
+
 /// Collects triangles for one panel.
 struct Painter<'a> {
     out: &'a mut Vec<Vertex>,
@@ -174,11 +227,24 @@ struct Painter<'a> {
 
 impl Painter<'_> {
     fn triangle(&mut self, a: [f32; 2], b: [f32; 2], c: [f32; 2], color: [f32; 4]) {
-        for p in [a, b, c] {
-            self.out.push(Vertex {
-                position: self.t.apply(p),
-                color,
-            });
+        let pts = [self.t.apply(a), self.t.apply(b), self.t.apply(c)];
+        let inside = |p: &[f32; 2]| {
+            p[0] >= self.t.clip[0]
+                && p[0] <= self.t.clip[2]
+                && p[1] >= self.t.clip[1]
+                && p[1] <= self.t.clip[3]
+        };
+        if pts.iter().all(inside) {
+            for position in pts {
+                self.out.push(Vertex { position, color });
+            }
+            return;
+        }
+        let poly = clip_polygon(&pts, self.t.clip);
+        for k in 1..poly.len().saturating_sub(1) {
+            for position in [poly[0], poly[k], poly[k + 1]] {
+                self.out.push(Vertex { position, color });
+            }
         }
     }
 
@@ -300,143 +366,224 @@ pub fn color_measure(color_by: ColorBy, stress: &[f32; 3], strain: &[f32; 3]) ->
     }
 }
 
-/// Displayed position of a vertex with the deformation exaggerated.
-fn exaggerate(rigid: [f32; 2], actual: [f32; 2], f: f32) -> [f32; 2] {
-    [
-        rigid[0] + f * (actual[0] - rigid[0]),
-        rigid[1] + f * (actual[1] - rigid[1]),
-    ]
+/// Displayed position of a point with the deformation exaggerated: its horizontal
+/// displacement from where the rigid motion of its structure would put it, times `f`.
+///
+/// Only the horizontal part is magnified: that is the storey drift and shear a building
+/// sways with. Vertical deformations (a slab flexing on its contact springs, columns
+/// shortening) are micrometres; magnified they would sink the base into the ground, so
+/// they are drawn true. The map stays affine on each block and continuous across joints,
+/// so connected blocks stay joined at any factor.
+pub fn exaggerate(rigid: [f32; 2], actual: [f32; 2], f: f32) -> [f32; 2] {
+    [rigid[0] + f * (actual[0] - rigid[0]), actual[1]]
+}
+
+/// A spacing of `1, 2 or 5 × 10ⁿ` metres at least `min` long (ticks, scale bars).
+pub fn nice_step(min: f32) -> f32 {
+    if min.is_nan() || min <= 0.0 || !min.is_finite() {
+        return 1.0;
+    }
+    let p = 10f32.powf(min.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * p)
+        .find(|&s| s >= min)
+        .unwrap_or(10.0 * p)
+}
+
+/// The height of the ground's top surface in a frame, m.
+pub fn ground_top(frame: &ModelFrame) -> Option<f32> {
+    frame.blocks.iter().find(|b| b.is_ground).map(|g| {
+        g.vertices
+            .iter()
+            .map(|v| v[1])
+            .fold(f32::NEG_INFINITY, f32::max)
+    })
 }
 
 /// Tessellates a scene view for a target of `target` pixels (width, height).
 pub fn build(view: &SceneView<'_>, target: [f32; 2]) -> Vec<Vertex> {
     let mut out = Vec::new();
     for panel in &view.panels {
-        let frame = panel.frame;
-        // The camera follows the base (the first non-ground block's centroid region).
-        let centre_x = frame.blocks.iter().find(|b| !b.is_ground).map_or(0.0, |b| {
-            b.vertices.iter().map(|v| v[0]).sum::<f32>() / b.vertices.len().max(1) as f32
-        });
         let mut p = Painter {
             out: &mut out,
-            t: Transform::new(panel, target, centre_x),
+            t: Transform::new(panel, target),
         };
-        let [x, y, w, h] = panel.rect;
-        // Background: the panel rectangle in clip space directly.
-        let to_clip = |px: f32, py: f32| [px * 2.0 / target[0] - 1.0, 1.0 - py * 2.0 / target[1]];
-        let (a, b, c, d) = (
-            to_clip(x, y),
-            to_clip(x + w, y),
-            to_clip(x + w, y + h),
-            to_clip(x, y + h),
-        );
-        for q in [a, b, c, a, c, d] {
-            p.out.push(Vertex {
-                position: q,
-                color: SKY,
-            });
-        }
-        let ground = frame.blocks.iter().find(|b| b.is_ground);
-        if view.layers.ground
-            && let Some(g) = ground
-        {
-            p.polygon(&g.vertices, GROUND);
-            // Markings every metre near the structure, so the ground's motion shows.
-            let top = g
-                .vertices
-                .iter()
-                .map(|v| v[1])
-                .fold(f32::NEG_INFINITY, f32::max);
-            let gx = frame.probes.ground_disp as f32;
-            let half = panel.window[0] * 3.0;
-            let start = ((centre_x - half - gx).floor()) as i64;
-            for k in 0..(2.0 * half) as i64 + 2 {
-                let xm = (start + k) as f32 + gx;
-                let depth = if (start + k) % 5 == 0 { 0.6 } else { 0.3 };
-                p.line([xm, top], [xm, top - depth], 1.5, GROUND_MARK);
-            }
-        }
-        for blk in frame.blocks.iter().filter(|b| !b.is_ground) {
-            let pts: Vec<[f32; 2]> = blk
-                .rigid
-                .iter()
-                .zip(&blk.vertices)
-                .map(|(r, a)| exaggerate(*r, *a, view.exaggeration))
-                .collect();
-            if view.layers.blocks {
-                let color = match view.color_by {
-                    ColorBy::Material => MATERIAL,
-                    c => colormap(
-                        color_measure(c, &blk.stress, &blk.strain)
-                            / view.color_max.max(f32::MIN_POSITIVE),
-                    ),
-                };
-                p.polygon(&pts, color);
-            }
-            if view.layers.outlines {
-                p.outline(&pts, 1.5, OUTLINE);
-            }
-        }
-        if view.layers.connections {
-            for tri in &frame.connections {
-                p.outline(tri, 1.0, CONNECTION);
-            }
-        }
-        if view.layers.bolts {
-            for bolt in &frame.bolts {
-                p.spring(bolt[0], bolt[1], 8.0, 6, 2.0, BOLT);
-            }
-        }
-        if view.layers.contacts {
-            for c in &frame.contacts {
-                draw_contact(&mut p, c);
-            }
-        }
-        if view.layers.slip
-            && let Some(g) = ground
-        {
-            let top = g
-                .vertices
-                .iter()
-                .map(|v| v[1])
-                .fold(f32::NEG_INFINITY, f32::max);
-            let slip = frame.probes.slip as f32;
-            let gx = frame.probes.ground_disp as f32;
-            // Trace: the range of base positions on the ground so far (skid marks).
-            let lift = 4.0 * p.t.metres_per_pixel;
-            let [lo, hi] = panel.slip_range;
-            if hi > lo {
-                p.line(
-                    [centre_x - slip + lo, top - lift],
-                    [centre_x - slip + hi, top - lift],
-                    4.0,
-                    TRACE,
-                );
-            }
-            // Arrow from where the base started on the ground to where it is now.
-            let mark = centre_x - slip;
-            p.line(
-                [mark, top - 3.0 * lift],
-                [mark, top + 3.0 * lift],
-                2.0,
-                SLIP_ARROW,
-            );
-            if slip.abs() > 2.0 * p.t.metres_per_pixel {
-                p.arrow(
-                    [mark, top + 2.0 * lift],
-                    [centre_x, top + 2.0 * lift],
-                    3.0,
-                    SLIP_ARROW,
-                );
-            }
-            let _ = gx;
-        }
+        draw_panel(&mut p, panel, view);
     }
     out
 }
 
+fn draw_panel(p: &mut Painter<'_>, panel: &PanelView<'_>, view: &SceneView<'_>) {
+    let frame = panel.frame;
+    let [x, y, w, h] = panel.rect;
+    let mpp = p.t.metres_per_pixel;
+    // World box of the panel.
+    let (cx, cy) = (panel.view.centre[0], panel.view.centre[1]);
+    let (x0, x1) = (cx - 0.5 * w * mpp, cx + 0.5 * w * mpp);
+    let (y0, y1) = (cy - 0.5 * h * mpp, cy + 0.5 * h * mpp);
+    p.quad([x0, y0], [x1, y0], [x1, y1], [x0, y1], SKY);
+    let _ = (x, y);
+    let factor = if panel.close_up {
+        1.0
+    } else {
+        view.exaggeration
+    };
+    let top = ground_top(frame);
+    if view.layers.ground
+        && let Some(g) = frame.blocks.iter().find(|b| b.is_ground)
+    {
+        p.polygon(&g.vertices, GROUND);
+        // Marks that move with the ground, so its motion shows: spaced for the scale.
+        let top = top.unwrap_or(0.0);
+        let gx = frame.probes.ground_disp as f32;
+        let step = nice_step(30.0 * mpp);
+        let first = ((x0 - gx) / step).floor() as i64;
+        let last = ((x1 - gx) / step).ceil() as i64;
+        for k in first..=last.min(first + 400) {
+            let xm = k as f32 * step + gx;
+            let depth = if k % 5 == 0 { 14.0 } else { 7.0 } * mpp;
+            p.line([xm, top], [xm, top - depth], 1.5, GROUND_MARK);
+        }
+    }
+    if panel.close_up && view.layers.slip {
+        // Where the base started, carried along by the ground: a ghost outline.
+        let ghost = &frame.base_start;
+        p.polygon(ghost, GHOST_FILL);
+        dashed_outline(p, ghost, 2.0, 8.0, GHOST_LINE);
+    }
+    // The connection elements are elastic material between the blocks they join: filled
+    // like an unstrained block, so that a column and its slab read as one structure.
+    let connections: Vec<Vec<[f32; 2]>> = frame
+        .connections
+        .iter()
+        .map(|c| {
+            (0..3)
+                .map(|k| exaggerate(c.rigid[k], c.points[k], factor))
+                .collect()
+        })
+        .collect();
+    if view.layers.blocks {
+        let fill = match view.color_by {
+            _ if panel.close_up => MATERIAL,
+            ColorBy::Material => MATERIAL,
+            _ => colormap(0.0),
+        };
+        for pts in &connections {
+            p.polygon(pts, fill);
+        }
+    }
+    for blk in frame.blocks.iter().filter(|b| !b.is_ground) {
+        let pts: Vec<[f32; 2]> = blk
+            .rigid
+            .iter()
+            .zip(&blk.vertices)
+            .map(|(r, a)| exaggerate(*r, *a, factor))
+            .collect();
+        if view.layers.blocks {
+            // The close-up is about positions, not strain: plain blocks let the ghost and
+            // the slip arrow stand out.
+            let color = match view.color_by {
+                _ if panel.close_up => MATERIAL,
+                ColorBy::Material => MATERIAL,
+                c => colormap(
+                    color_measure(c, &blk.stress, &blk.strain)
+                        / view.color_max.max(f32::MIN_POSITIVE),
+                ),
+            };
+            p.polygon(&pts, color);
+        }
+        if view.layers.outlines {
+            p.outline(&pts, 1.5, OUTLINE);
+        }
+    }
+    if view.layers.connections {
+        for pts in &connections {
+            p.outline(pts, 1.0, CONNECTION);
+        }
+    }
+    if view.layers.bolts {
+        for b in &frame.bolts {
+            let a = exaggerate(b.rigid[0], b.points[0], factor);
+            let c = exaggerate(b.rigid[1], b.points[1], factor);
+            p.spring(a, c, 8.0, 6, 2.0, BOLT);
+        }
+    }
+    if view.layers.contacts {
+        for c in &frame.contacts {
+            let at = exaggerate(c.rigid, c.point, factor);
+            draw_contact(p, c, at);
+        }
+    }
+    if view.layers.slip
+        && let Some(top) = top
+    {
+        draw_slip(p, panel, top);
+    }
+}
+
+/// A polygon's outline as dashes `dash_px` long.
+fn dashed_outline(p: &mut Painter<'_>, pts: &[[f32; 2]], width_px: f32, dash_px: f32, c: [f32; 4]) {
+    let dash = dash_px * p.t.metres_per_pixel;
+    for k in 0..pts.len() {
+        let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
+        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+        let n = (len / dash).floor().min(2000.0) as usize;
+        for i in (0..n).step_by(2) {
+            let (s0, s1) = (
+                i as f32 * dash / len,
+                ((i + 1) as f32 * dash / len).min(1.0),
+            );
+            let at = |s: f32| [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+            p.line(at(s0), at(s1), width_px, c);
+        }
+    }
+}
+
+/// The slip: the range the base has slipped over (skid marks on the ground) and an arrow
+/// from where the base started (on the ground) to where it is.
+fn draw_slip(p: &mut Painter<'_>, panel: &PanelView<'_>, top: f32) {
+    let frame = panel.frame;
+    let mpp = p.t.metres_per_pixel;
+    let slip = frame.probes.slip as f32;
+    let Some(base) = frame.blocks.get(frame.base) else {
+        return;
+    };
+    // A reference point of the base: its left end, now and at the start (on the ground).
+    let left_now = base
+        .vertices
+        .iter()
+        .map(|v| v[0])
+        .fold(f32::INFINITY, f32::min);
+    let left_start = left_now - slip;
+    let [lo, hi] = panel.slip_range;
+    if hi > lo {
+        p.line(
+            [left_start + lo, top - 4.0 * mpp],
+            [left_start + hi, top - 4.0 * mpp],
+            4.0,
+            TRACE,
+        );
+    }
+    let (height, width) = if panel.close_up {
+        (24.0, 4.0)
+    } else {
+        (12.0, 2.0)
+    };
+    p.line(
+        [left_start, top - height * mpp],
+        [left_start, top + height * mpp],
+        width,
+        SLIP_ARROW,
+    );
+    if slip.abs() > 3.0 * mpp {
+        let at = top + 0.6 * height * mpp;
+        p.arrow([left_start, at], [left_now, at], 1.5 * width, SLIP_ARROW);
+    }
+}
+
 /// A contact as a short normal spring (and a shear spring when stuck) at its point.
-fn draw_contact(p: &mut Painter<'_>, c: &ContactFrame) {
+fn draw_contact(p: &mut Painter<'_>, c: &ContactFrame, a: [f32; 2]) {
     let color = match c.state {
         1 => LOCKED,
         2 => SLIDING,
@@ -446,7 +593,6 @@ fn draw_contact(p: &mut Painter<'_>, c: &ContactFrame) {
     let n = [c.tangent[1], -c.tangent[0]];
     // The vertex sits on the edge; the edge's outward normal points to the vertex block.
     let len = 18.0 * mpp;
-    let a = c.point;
     let b = [a[0] - n[0] * len, a[1] - n[1] * len];
     p.spring(b, a, 4.0, 3, 2.0, color);
     if c.state == 1 {

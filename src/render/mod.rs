@@ -4,11 +4,13 @@
 //! window's surface or an offscreen texture (see [`offscreen`]).
 
 pub mod geometry;
+pub mod layout;
 pub mod offscreen;
 
 use wgpu::util::DeviceExt;
 
-pub use geometry::{ColorBy, Layers, PanelView, SceneView, Vertex};
+pub use geometry::{ColorBy, Layers, PanelView, SceneView, Vertex, ViewBox};
+pub use layout::{Camera, Fit, Follow};
 
 /// The scene renderer.
 pub struct Renderer {
@@ -102,12 +104,18 @@ impl Renderer {
     /// Tessellates the view and uploads it; call before [`Renderer::draw`].
     pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, view: &SceneView<'_>) {
         let vertices = geometry::build(view, [self.size[0] as f32, self.size[1] as f32]);
+        self.upload(device, queue, &vertices);
+    }
+
+    /// Uploads triangles tessellated already (clip space of the target); call before
+    /// [`Renderer::draw`].
+    pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, vertices: &[Vertex]) {
         if vertices.len() > self.capacity {
             self.capacity = vertices.len().next_power_of_two();
             self.vertex_buffer = Self::buffer(device, self.capacity);
         }
         if !vertices.is_empty() {
-            queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(&vertices));
+            queue.write_buffer(&self.vertex_buffer, 0, bytemuck::cast_slice(vertices));
         }
         self.vertex_count = vertices.len() as u32;
     }

@@ -44,6 +44,9 @@ pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
     if let Some(i) = spec.integrator {
         i.validate()?;
     }
+    if let Some(pga) = spec.pga_g {
+        require_range("--pga", pga, MIN_AMPLITUDE_G, MAX_ACCEL_G, "g")?;
+    }
     match &spec.excitation {
         ExcitationSpec::Scene => {}
         ExcitationSpec::Harmonic {
@@ -161,9 +164,8 @@ pub fn check_steps(steps: f64, what: &str, confirmed: bool) -> Result<()> {
             "--duration/--dt",
             format!(
                 "{what} would take {steps:.3e} steps, beyond the limit of {MAX_STEPS:e} \
-                 (at least {} h of computing at the two-block model's 3e5 steps/s); \
-                 shorten --duration, enlarge --dt, or give --confirm-large to run it anyway",
-                show(hours)
+                 (at least {hours:.1} h of computing at the two-block model's 3e5 steps/s); \
+                 shorten --duration, enlarge --dt, or give --confirm-large to run it anyway"
             ),
         ));
     }

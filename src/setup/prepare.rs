@@ -61,6 +61,8 @@ pub struct RunSetup {
     pub fixed_base: bool,
     /// `harmonic` or the record's name.
     pub excitation_label: String,
+    /// Factor applied to the ground motion to reach [`RunSpec::pga_g`] (1: as given).
+    pub motion_scale: f64,
     /// Things the user should know about the run (resolution, applicability).
     pub warnings: Vec<String>,
     /// The user confirmed a run beyond the step limit (`--confirm-large`).
@@ -92,6 +94,11 @@ impl RunSpec {
         };
         setup.dt = dt;
         setup.integrator = integrator;
+        if let Some(pga_g) = self.pga_g {
+            let (motion, factor) = scale_to_pga(&setup.motion, pga_g, setup.duration)?;
+            setup.motion = motion;
+            setup.motion_scale = factor;
+        }
         // A sliding base travels at most as far as the ground moves: make sure the ground
         // block is long enough.
         let travel = max_abs_displacement(&setup.motion, setup.duration);
@@ -234,6 +241,7 @@ impl RunSpec {
             friction,
             fixed_base: self.fixed_base,
             excitation_label,
+            motion_scale: 1.0,
             warnings: Vec::new(),
             confirm_large: self.confirm_large,
         }
@@ -357,6 +365,23 @@ impl RunSetup {
         scene
     }
 
+    /// The run's scene with the sliding joint's friction coefficient set to `friction`
+    /// (a side-by-side comparison of friction values).
+    pub fn friction_variant_scene(&self, friction: f64) -> Result<Scene> {
+        crate::error::require_range(
+            "comparison friction",
+            friction,
+            0.0,
+            crate::limits::MAX_FRICTION,
+            "",
+        )?;
+        let mut scene = self.scene.clone();
+        for c in scene.contacts.iter_mut().filter(|c| c.name == self.joint) {
+            c.friction = friction;
+        }
+        Ok(scene)
+    }
+
     /// The two-block roles, α and Ω/ω, when this is a two-block run.
     pub fn two_block(&self) -> Option<(&TwoBlockRoles, f64, Option<f64>)> {
         match &self.roles {
@@ -402,4 +427,25 @@ fn max_abs_displacement(motion: &GroundMotion, duration: f64) -> f64 {
     (0..=n)
         .map(|k| motion.displacement(duration * k as f64 / n as f64).abs())
         .fold(0.0, f64::max)
+}
+
+/// The ground motion scaled to a peak acceleration of `pga_g` over `duration`, and the
+/// factor applied.
+fn scale_to_pga(motion: &GroundMotion, pga_g: f64, duration: f64) -> Result<(GroundMotion, f64)> {
+    let peak = motion.peak_accel(duration) / crate::ground_motion::STANDARD_GRAVITY;
+    if !(peak.is_finite() && peak > 0.0) {
+        return Err(Error::invalid(
+            "--pga",
+            "the ground motion is zero over the run; there is nothing to scale",
+        ));
+    }
+    let factor = pga_g / peak;
+    let scaled = match motion {
+        GroundMotion::Record(r) => GroundMotion::Record(Arc::new(r.scaled(factor)?)),
+        GroundMotion::Harmonic(h) => GroundMotion::Harmonic(Harmonic {
+            amplitude: h.amplitude * factor,
+            ..*h
+        }),
+    };
+    Ok((scaled, factor))
 }

@@ -158,6 +158,9 @@ pub struct RunSpec {
     pub friction: Option<f64>,
     /// Fix the base: the sliding joint is bonded and never slides.
     pub fixed_base: bool,
+    /// Scale the ground motion to this peak ground acceleration over the run, g (default:
+    /// as given).
+    pub pga_g: Option<f64>,
     /// Ground model of a DDA run (default: the scene's).
     pub ground: Option<GroundKind>,
     /// Duration, s (default: the record's length, or [`super::defaults::HARMONIC_DURATION_S`]).

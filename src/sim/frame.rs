@@ -1,5 +1,14 @@
 //! The plain-data state the simulation publishes: what a renderer or a plot needs of a
-//! model at one instant, copied out of the solver (bevy's "extract" step).
+//! model at one instant, copied out of the solver (bevy's "extract" step), and the
+//! full-rate samples (one row per solver step) that spectra and peaks are computed from.
+//!
+//! Exaggerated deformation needs, for every drawn point, where the rigid motion of its
+//! structure would have put it. Blocks joined by connection elements, bolts or bonded
+//! contacts form one structure whose rigid motion is that of its anchor (the base slab for
+//! the building, the raft for the two-mass model); a block joined to nothing is its own
+//! anchor. Drawing `rigid + factor·(actual − rigid)` then magnifies storey drift and strain
+//! alike, and since `actual` and `rigid` are both continuous across a connection, connected
+//! blocks stay joined at any factor.
 
 use crate::dda::{Dda, EnergyTerms};
 use crate::ground_motion::GroundMotion;
@@ -10,8 +19,8 @@ use crate::model::geometry::Point;
 pub struct BlockFrame {
     /// Current vertices, m (relative to the frame's origin).
     pub vertices: Vec<[f32; 2]>,
-    /// Where the vertices would be under the block's rigid motion alone: displayed
-    /// deformation is exaggerated as `rigid + factor·(vertices − rigid)`.
+    /// Where the vertices would be under the rigid motion of the block's structure alone
+    /// (see the module docs): displayed as `rigid + factor·(vertices − rigid)`.
     pub rigid: Vec<[f32; 2]>,
     /// Stress (σx, σy, τxy), Pa.
     pub stress: [f32; 3],
@@ -26,12 +35,24 @@ pub struct BlockFrame {
 pub struct ContactFrame {
     /// The vertex in contact, m.
     pub point: [f32; 2],
+    /// Where the rigid motion of the vertex's structure would put it (for exaggeration).
+    pub rigid: [f32; 2],
     /// Unit tangent of the edge.
     pub tangent: [f32; 2],
     /// Normal force, N.
     pub normal_force: f32,
     /// 0 open, 1 locked, 2 sliding.
     pub state: u8,
+}
+
+/// Points attached to blocks — a bolt's two ends, a connection element's three nodes —
+/// where they are and where the rigid motion of their structure would put them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Attached<const N: usize> {
+    /// Current positions, m.
+    pub points: [[f32; 2]; N],
+    /// Rigid-motion positions, m (for exaggeration).
+    pub rigid: [[f32; 2]; N],
 }
 
 /// Scalar responses at one instant (the plots' data).
@@ -62,24 +83,118 @@ pub struct ModelFrame {
     pub time: f64,
     /// Blocks in scene order.
     pub blocks: Vec<BlockFrame>,
+    /// Index of the base block (the sliding slab or raft) in `blocks`.
+    pub base: usize,
+    /// The base's outline at t = 0 relative to the ground: drawn on the ground, moved
+    /// with it, it shows where the base started (its "ghost").
+    pub base_start: Vec<[f32; 2]>,
     /// Contacts of the last step.
     pub contacts: Vec<ContactFrame>,
     /// Bolts (end points).
-    pub bolts: Vec<[[f32; 2]; 2]>,
+    pub bolts: Vec<Attached<2>>,
     /// Connection elements (node positions).
-    pub connections: Vec<[[f32; 2]; 3]>,
+    pub connections: Vec<Attached<3>>,
     /// Scalars for plots.
     pub probes: Probes,
 }
 
+/// Full-rate samples of one model: one row per solver step (steps need not be evenly
+/// spaced; spectra resample them onto a uniform grid).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Samples {
+    /// Time, s.
+    pub time: Vec<f64>,
+    /// Ground acceleration, m/s².
+    pub ground_accel: Vec<f64>,
+    /// Absolute base acceleration, m/s².
+    pub base_accel: Vec<f64>,
+    /// Absolute roof acceleration, m/s².
+    pub roof_accel: Vec<f64>,
+    /// Slip of the base relative to the ground, m.
+    pub slip: Vec<f64>,
+    /// Roof displacement relative to the base, m.
+    pub drift: Vec<f64>,
+}
+
+impl Samples {
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.time.len()
+    }
+
+    /// Whether there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.time.is_empty()
+    }
+
+    /// Moves the rows of `other` to the end of these.
+    pub fn append(&mut self, other: &mut Samples) {
+        self.time.append(&mut other.time);
+        self.ground_accel.append(&mut other.ground_accel);
+        self.base_accel.append(&mut other.base_accel);
+        self.roof_accel.append(&mut other.roof_accel);
+        self.slip.append(&mut other.slip);
+        self.drift.append(&mut other.drift);
+    }
+
+    /// Number of rows with time ≤ `t`.
+    pub fn count_until(&self, t: f64) -> usize {
+        self.time.partition_point(|&s| s <= t + 1e-9)
+    }
+
+    fn push(&mut self, t: f64, p: &Probes) {
+        self.time.push(t);
+        self.ground_accel.push(p.ground_accel);
+        self.base_accel.push(p.base_accel);
+        self.roof_accel.push(p.roof_accel);
+        self.slip.push(p.slip);
+        self.drift.push(p.drift);
+    }
+}
+
+/// A rigid motion of the plane: x ↦ c + R(θ)(X − c₀).
+#[derive(Debug, Clone, Copy)]
+struct RigidMotion {
+    from: Point,
+    to: Point,
+    sin: f64,
+    cos: f64,
+}
+
+impl RigidMotion {
+    fn apply(&self, p: Point) -> Point {
+        let (dx, dy) = (p[0] - self.from[0], p[1] - self.from[1]);
+        [
+            self.to[0] + self.cos * dx - self.sin * dy,
+            self.to[1] + self.sin * dx + self.cos * dy,
+        ]
+    }
+}
+
+/// Union-find over block indices (the structures of a scene).
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
 /// What the extractor needs to know about a model once: which blocks are base and roof,
-/// and the reference shapes for the rigid motion.
+/// each block's anchor and the reference positions of everything drawn.
 #[derive(Debug, Clone)]
 pub struct Extractor {
     base: usize,
     roof: usize,
-    /// Per block: vertex offsets from the centroid in the reference state.
-    offsets: Vec<Vec<Point>>,
+    /// Per block: the block whose rigid motion carries it (see the module docs).
+    anchor: Vec<usize>,
+    /// Per block: reference centroid and rotation (the anchors' are used).
+    reference_pose: Vec<(Point, f64)>,
+    /// Per block: vertices in the reference state.
+    reference_vertices: Vec<Vec<Point>>,
+    /// Bolts' ends and connection nodes in the reference state.
+    reference_bolts: Vec<[Point; 2]>,
+    reference_connections: Vec<[Point; 3]>,
     reference_strain: Vec<[f64; 3]>,
     /// World position subtracted from every coordinate (kept near the structure so f32 is
     /// precise to well below a millimetre).
@@ -89,23 +204,58 @@ pub struct Extractor {
 impl Extractor {
     /// Captures the reference state of a freshly built model.
     pub fn new(dda: &Dda, base: usize, roof: usize) -> Self {
-        let offsets = dda
-            .blocks()
-            .iter()
-            .map(|b| {
-                b.vertices
-                    .iter()
-                    .map(|v| [v[0] - b.moments.centroid[0], v[1] - b.moments.centroid[1]])
-                    .collect()
+        let blocks = dda.blocks();
+        let g = dda.ground();
+        let mut parent: Vec<usize> = (0..blocks.len()).collect();
+        let mut join = |a: usize, b: usize| {
+            if a != g && b != g {
+                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                parent[ra] = rb;
+            }
+        };
+        for bolt in dda.bolts() {
+            join(bolt.blocks[0], bolt.blocks[1]);
+        }
+        for c in dda.connections() {
+            join(c.blocks[0], c.blocks[1]);
+            join(c.blocks[1], c.blocks[2]);
+        }
+        for c in dda.contacts().iter().filter(|c| c.props.bonded) {
+            join(c.key.vertex_block, c.key.edge_block);
+        }
+        // The anchor of a structure: the base if it belongs to it, else its largest block.
+        let root_base = find(&mut parent, base);
+        let mut anchor_of_root: Vec<Option<usize>> = vec![None; blocks.len()];
+        anchor_of_root[root_base] = Some(base);
+        for i in 0..blocks.len() {
+            let r = find(&mut parent, i);
+            let better = match anchor_of_root[r] {
+                None => true,
+                Some(a) => r != root_base && blocks[i].moments.area > blocks[a].moments.area,
+            };
+            if better {
+                anchor_of_root[r] = Some(i);
+            }
+        }
+        let anchor = (0..blocks.len())
+            .map(|i| {
+                let r = find(&mut parent, i);
+                anchor_of_root[r].unwrap_or(i)
             })
             .collect();
-        let reference_strain = dda.blocks().iter().map(|b| b.strain).collect();
-        let origin = dda.blocks()[base].moments.centroid;
+        let origin = blocks[base].moments.centroid;
         Self {
             base,
             roof,
-            offsets,
-            reference_strain,
+            anchor,
+            reference_pose: blocks
+                .iter()
+                .map(|b| (b.moments.centroid, b.rotation))
+                .collect(),
+            reference_vertices: blocks.iter().map(|b| b.vertices.clone()).collect(),
+            reference_bolts: dda.bolts().iter().map(|b| b.points).collect(),
+            reference_connections: dda.connections().iter().map(|c| c.nodes).collect(),
+            reference_strain: blocks.iter().map(|b| b.strain).collect(),
             origin: [origin[0], 0.0],
         }
     }
@@ -119,31 +269,80 @@ impl Extractor {
         ]
     }
 
+    /// The rigid motion of every block's anchor since the reference state.
+    fn rigid_motions(&self, dda: &Dda) -> Vec<RigidMotion> {
+        let blocks = dda.blocks();
+        self.anchor
+            .iter()
+            .map(|&a| {
+                let (c0, r0) = self.reference_pose[a];
+                let (sin, cos) = (blocks[a].rotation - r0).sin_cos();
+                RigidMotion {
+                    from: c0,
+                    to: blocks[a].moments.centroid,
+                    sin,
+                    cos,
+                }
+            })
+            .collect()
+    }
+
+    /// The scalar responses now.
+    pub fn probes(&self, dda: &Dda, motion: Option<&GroundMotion>) -> Probes {
+        // Slip, drift and the accelerations as every front end defines them.
+        let r = crate::setup::Probe {
+            base: self.base,
+            roof: self.roof,
+        }
+        .measure(dda, motion);
+        Probes {
+            ground_accel: r.ground_accel,
+            ground_disp: r.ground_disp,
+            base_accel: r.base_accel,
+            roof_accel: r.roof_accel,
+            slip: r.slip,
+            drift: r.drift,
+            joint_force: 0.0,
+            energy: EnergyTerms::default(),
+        }
+    }
+
+    /// Appends the responses now to full-rate samples (call once per solver step).
+    pub fn sample(&self, dda: &Dda, motion: Option<&GroundMotion>, into: &mut Samples) {
+        into.push(dda.time(), &self.probes(dda, motion));
+    }
+
     /// Copies the model's current state out.
     pub fn extract(&self, dda: &Dda, motion: Option<&GroundMotion>) -> ModelFrame {
         let t = dda.time();
         let g = dda.ground();
         let shift = dda.frame_displacement();
+        let rigid = self.rigid_motions(dda);
+        let carry = |block: usize, p: Point| {
+            if block == g {
+                self.local(p, shift)
+            } else {
+                self.local(rigid[block].apply(p), shift)
+            }
+        };
         let blocks = dda
             .blocks()
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let c = b.moments.centroid;
-                let (s, co) = b.rotation.sin_cos();
-                let rigid = self.offsets[i]
-                    .iter()
-                    .map(|o| {
-                        self.local(
-                            [c[0] + co * o[0] - s * o[1], c[1] + s * o[0] + co * o[1]],
-                            shift,
-                        )
-                    })
-                    .collect();
                 let r = &self.reference_strain[i];
+                let actual: Vec<[f32; 2]> =
+                    b.vertices.iter().map(|&v| self.local(v, shift)).collect();
                 BlockFrame {
-                    vertices: b.vertices.iter().map(|&v| self.local(v, shift)).collect(),
-                    rigid,
+                    rigid: if i == g {
+                        actual.clone()
+                    } else {
+                        self.reference_vertices[i]
+                            .iter()
+                            .map(|&v| carry(i, v))
+                            .collect()
+                    },
+                    vertices: actual,
                     stress: b.stress.map(|v| v as f32),
                     strain: [
                         (b.strain[0] - r[0]) as f32,
@@ -167,48 +366,64 @@ impl Extractor {
                 } else if c.key.vertex_block == g {
                     joint_force += pull * c.tangent[0];
                 }
+                let vb = c.key.vertex_block;
+                let reference = self.reference_vertices[vb]
+                    .get(c.key.vertex)
+                    .copied()
+                    .unwrap_or(c.point);
                 ContactFrame {
                     point: self.local(c.point, shift),
+                    rigid: if vb == g {
+                        self.local(c.point, shift)
+                    } else {
+                        carry(vb, reference)
+                    },
                     tangent: [c.tangent[0] as f32, c.tangent[1] as f32],
                     normal_force: n as f32,
                     state: c.state.code(),
                 }
             })
             .collect();
-        // Slip, drift and the accelerations as every front end defines them.
-        let r = crate::setup::Probe {
-            base: self.base,
-            roof: self.roof,
-        }
-        .measure(dda, motion);
         let probes = Probes {
-            ground_accel: r.ground_accel,
-            ground_disp: r.ground_disp,
-            base_accel: r.base_accel,
-            roof_accel: r.roof_accel,
-            slip: r.slip,
-            drift: r.drift,
             joint_force,
             energy: dda.energy(),
+            ..self.probes(dda, motion)
         };
+        let ground_now = probes.ground_disp as f32;
+        let base_start = self.reference_vertices[self.base]
+            .iter()
+            .map(|&v| {
+                let p = self.local(v, 0.0);
+                [p[0] + ground_now, p[1]]
+            })
+            .collect();
         ModelFrame {
             time: t,
             blocks,
+            base: self.base,
+            base_start,
             contacts,
             bolts: dda
                 .bolts()
                 .iter()
-                .map(|b| {
-                    [
-                        self.local(b.points[0], shift),
-                        self.local(b.points[1], shift),
-                    ]
+                .zip(&self.reference_bolts)
+                .map(|(b, r)| Attached {
+                    points: b.points.map(|p| self.local(p, shift)),
+                    rigid: [carry(b.blocks[0], r[0]), carry(b.blocks[1], r[1])],
                 })
                 .collect(),
             connections: dda
                 .connections()
                 .iter()
-                .map(|c| c.nodes.map(|p| self.local(p, shift)))
+                .zip(&self.reference_connections)
+                .map(|(c, r)| Attached {
+                    points: c.nodes.map(|p| self.local(p, shift)),
+                    rigid: [
+                        carry(c.blocks[0], r[0]),
+                        carry(c.blocks[1], r[1]),
+                        carry(c.blocks[2], r[2]),
+                    ],
+                })
                 .collect(),
             probes,
         }

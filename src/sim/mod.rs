@@ -12,7 +12,7 @@ use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-pub use frame::{BlockFrame, ContactFrame, Extractor, ModelFrame, Probes};
+pub use frame::{Attached, BlockFrame, ContactFrame, Extractor, ModelFrame, Probes, Samples};
 
 use crate::Result;
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
@@ -54,6 +54,11 @@ pub struct SimConfig {
     pub dt: f64,
     /// Also run the fixed-base comparison.
     pub compare_fixed: bool,
+    /// Also run the sliding model with each of these friction coefficients (a side-by-side
+    /// comparison of friction values), after the main model and before the fixed base.
+    pub compare_friction: Vec<f64>,
+    /// Scale the ground motion to this peak ground acceleration, g (None: as recorded).
+    pub pga_g: Option<f64>,
     /// Duration, s (None: the record's length, or the default of harmonic input,
     /// [`crate::setup::defaults::HARMONIC_DURATION_S`]).
     pub duration: Option<f64>,
@@ -71,6 +76,8 @@ impl Default for SimConfig {
             integrator: Integrator::default(),
             dt: crate::setup::defaults::DT,
             compare_fixed: true,
+            compare_friction: Vec::new(),
+            pga_g: None,
             duration: None,
             // 100 frames per simulated second: smooth replay at up to 2× speed at 60 Hz,
             // and about 6 MB for a 30 s three-storey run.
@@ -87,14 +94,57 @@ pub struct PreparedRun {
     pub motion: GroundMotion,
     /// Duration, s.
     pub duration: f64,
-    /// The sliding model and, if requested, the fixed-base one.
+    /// The sliding model, the friction comparisons and, if requested, the fixed-base one.
     pub models: Vec<(Dda, Extractor)>,
+    /// One label per model ("sliding base, ρ = 0.01", "fixed base").
+    pub labels: Vec<String>,
+    /// What the ground motion is (for the panel and picture titles).
+    pub motion_info: MotionInfo,
     /// For two-block scenes: the exact mass-spring solution (time, slip, drift, base accel,
     /// roof accel), for overlaying on the DDA curves.
     pub exact: Option<ExactOverlay>,
     /// What the user should know about the run (e.g. a time step that barely resolves the
     /// excitation), from the shared set-up's checks.
     pub warnings: Vec<String>,
+}
+
+/// A description of a run's ground motion for people: name, source, peak, sampling.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MotionInfo {
+    /// Name ("el-centro", "harmonic 0.30 g, 1.00 Hz").
+    pub name: String,
+    /// Where it comes from (a record's provenance; empty for harmonic input).
+    pub source: String,
+    /// Peak ground acceleration as run (after any scaling), g.
+    pub pga_g: f64,
+    /// Sample interval of a record, s (None: harmonic).
+    pub dt: Option<f64>,
+    /// Length of a record, s (None: harmonic).
+    pub duration: Option<f64>,
+    /// Factor applied to the record to reach the chosen PGA (1: as recorded).
+    pub scale: f64,
+}
+
+impl MotionInfo {
+    fn of(motion: &GroundMotion, duration: f64, scale: f64) -> Self {
+        let (source, dt, length) = match motion {
+            GroundMotion::Record(r) => (r.provenance.clone(), Some(r.dt), Some(r.duration())),
+            _ => (String::new(), None, None),
+        };
+        Self {
+            name: motion.label(),
+            source,
+            pga_g: motion.peak_accel(duration) / crate::ground_motion::STANDARD_GRAVITY,
+            dt,
+            duration: length,
+            scale,
+        }
+    }
+}
+
+/// The label of a sliding model with joint friction `friction`.
+fn sliding_label(friction: f64) -> String {
+    format!("sliding base, ρ = {}", crate::post::format_number(friction))
 }
 
 /// The exact mass-spring solution of a two-block run, sampled for plotting.
@@ -142,6 +192,7 @@ impl SimConfig {
             duration: self.duration,
             dt: Some(self.dt),
             integrator: Some(self.integrator),
+            pga_g: self.pga_g,
             ..RunSpec::default()
         })
     }
@@ -152,14 +203,22 @@ impl SimConfig {
 pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
     let setup = config.spec()?.prepare()?;
     let exact = exact_overlay(&setup, config.frame_dt)?;
-    let mut models = Vec::new();
-    let mut scenes = vec![setup.scene.clone()];
-    if config.compare_fixed {
-        scenes.push(setup.fixed_base_scene());
+    let motion_info = MotionInfo::of(&setup.motion, setup.duration, setup.motion_scale);
+    // The models: the main one, the friction comparisons, the fixed base; each a variant
+    // of the one set-up's scene.
+    let mut scenes = vec![(setup.scene.clone(), sliding_label(setup.friction))];
+    for &f in &config.compare_friction {
+        scenes.push((setup.friction_variant_scene(f)?, sliding_label(f)));
     }
-    for scene in &scenes {
+    if config.compare_fixed {
+        scenes.push((setup.fixed_base_scene(), "fixed base".to_string()));
+    }
+    let mut models = Vec::new();
+    let mut labels = Vec::new();
+    for (scene, label) in &scenes {
         let (dda, probe) = setup.build_dda(scene, setup.solver_params())?;
         let ex = Extractor::new(&dda, probe.base, probe.roof);
+        labels.push(label.clone());
         models.push((dda, ex));
     }
     Ok(PreparedRun {
@@ -167,9 +226,93 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
         motion: setup.motion,
         duration: setup.duration,
         models,
+        labels,
+        motion_info,
         exact,
         warnings: setup.warnings,
     })
+}
+
+impl PreparedRun {
+    /// The models' state now, as a frame set.
+    pub fn frame_set(&self) -> FrameSet {
+        FrameSet {
+            time: self.models.first().map_or(0.0, |(d, _)| d.time()),
+            models: self
+                .models
+                .iter()
+                .map(|(d, ex)| ex.extract(d, Some(&self.motion)))
+                .collect(),
+        }
+    }
+
+    /// Full-rate samples holding the state now (the first row of a run).
+    pub fn initial_samples(&self) -> Vec<Samples> {
+        self.models
+            .iter()
+            .map(|(d, ex)| {
+                let mut s = Samples::default();
+                ex.sample(d, Some(&self.motion), &mut s);
+                s
+            })
+            .collect()
+    }
+
+    /// Advances every model to time `t`, appending one row per solver step to `samples`.
+    pub fn advance_to(&mut self, t: f64, samples: &mut [Samples]) -> Result<()> {
+        let motion = &self.motion;
+        for ((dda, ex), s) in self.models.iter_mut().zip(samples.iter_mut()) {
+            dda.run_until(t, |d, _| ex.sample(d, Some(motion), s))?;
+        }
+        Ok(())
+    }
+
+    /// The message that announces this run to a UI (takes the exact overlay).
+    pub fn started_message(&mut self, generation: u64, config: &SimConfig) -> SimMessage {
+        SimMessage::Started {
+            generation,
+            config: Box::new(config.clone()),
+            duration: self.duration,
+            labels: self.labels.clone(),
+            motion: Box::new(self.motion_info.clone()),
+            exact: self.exact.take().map(Box::new),
+            first: Box::new(self.frame_set()),
+        }
+    }
+}
+
+/// Runs a configuration to `until` (at most its duration) on this thread and returns what
+/// the simulation thread would have posted: started, all frames (every `frame_dt`) with
+/// their samples, finished. Pictures and videos are drawn from it as the window would.
+pub fn run_to_messages(config: &SimConfig, until: f64) -> Result<Vec<SimMessage>> {
+    let start = Instant::now();
+    let mut run = prepare(config)?;
+    let end = until.min(run.duration);
+    let mut samples = run.initial_samples();
+    let mut messages = vec![run.started_message(1, config)];
+    let mut frames = Vec::new();
+    let mut k = 1u64;
+    loop {
+        let t = (k as f64 * config.frame_dt).min(end);
+        run.advance_to(t, &mut samples)?;
+        frames.push(run.frame_set());
+        if t >= end - 1e-12 {
+            break;
+        }
+        k += 1;
+    }
+    messages.push(SimMessage::Frames {
+        generation: 1,
+        frames,
+        samples,
+        speed: end / start.elapsed().as_secs_f64().max(1e-9),
+        extract_us: 0.0,
+    });
+    messages.push(SimMessage::Finished {
+        generation: 1,
+        wall_time_s: start.elapsed().as_secs_f64(),
+    });
+    Ok(messages)
 }
 
 /// The exact mass-spring solution of a two-block run, sampled every `frame_dt` seconds.
@@ -215,8 +358,10 @@ pub enum SimMessage {
         config: Box<SimConfig>,
         /// Duration, s.
         duration: f64,
-        /// Model labels ("sliding base", "fixed base").
+        /// Model labels ("sliding base, ρ = 0.01", "fixed base").
         labels: Vec<String>,
+        /// The ground motion as run.
+        motion: Box<MotionInfo>,
         /// The exact mass-spring overlay (two-block scenes).
         exact: Option<Box<ExactOverlay>>,
         /// The first frame (t = 0).
@@ -228,6 +373,8 @@ pub enum SimMessage {
         generation: u64,
         /// Frames.
         frames: Vec<FrameSet>,
+        /// Full-rate samples since the last message, one set per model.
+        samples: Vec<Samples>,
         /// Simulated seconds per wall-clock second so far.
         speed: f64,
         /// Mean time to copy one frame set out of the solvers, µs.
@@ -258,6 +405,9 @@ pub enum SimCommand {
     Quit,
 }
 
+/// Called by the simulation thread after it posts a message (a UI wakes up to show it).
+pub type Waker = Box<dyn Fn() + Send>;
+
 /// The UI's end of the simulation thread.
 pub struct SimHandle {
     commands: Sender<SimCommand>,
@@ -269,11 +419,25 @@ pub struct SimHandle {
 impl SimHandle {
     /// Spawns the thread, idle until a [`SimCommand::Run`].
     pub fn spawn() -> Self {
+        Self::spawn_with_waker(Box::new(|| {}))
+    }
+
+    /// Spawns the thread; it calls `waker` after each message it posts, so that a UI
+    /// that only repaints on demand shows new frames at once.
+    pub fn spawn_with_waker(waker: Waker) -> Self {
         let (commands, command_rx) = channel();
         let (message_tx, messages) = channel();
         let thread = std::thread::Builder::new()
             .name("slidebase-sim".into())
-            .spawn(move || sim_thread(command_rx, message_tx))
+            .spawn(move || {
+                sim_thread(
+                    command_rx,
+                    Outbox {
+                        tx: message_tx,
+                        waker,
+                    },
+                )
+            })
             .ok();
         Self {
             commands,
@@ -297,7 +461,21 @@ impl Drop for SimHandle {
     }
 }
 
-fn sim_thread(commands: Receiver<SimCommand>, out: Sender<SimMessage>) {
+/// The thread's end of the message channel.
+struct Outbox {
+    tx: Sender<SimMessage>,
+    waker: Waker,
+}
+
+impl Outbox {
+    fn send(&self, msg: SimMessage) -> std::result::Result<(), ()> {
+        let sent = self.tx.send(msg).map_err(|_| ());
+        (self.waker)();
+        sent
+    }
+}
+
+fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
     let mut generation = 0u64;
     let mut pending: Option<SimConfig> = None;
     loop {
@@ -328,7 +506,7 @@ fn run_one(
     generation: u64,
     config: &SimConfig,
     commands: &Receiver<SimCommand>,
-    out: &Sender<SimMessage>,
+    out: &Outbox,
 ) -> RunEnd {
     let start = Instant::now();
     let mut run = match prepare(config) {
@@ -341,27 +519,8 @@ fn run_one(
             return RunEnd::Failed;
         }
     };
-    let labels = if run.models.len() > 1 {
-        vec!["sliding base".to_string(), "fixed base".to_string()]
-    } else {
-        vec!["sliding base".to_string()]
-    };
-    let first = FrameSet {
-        time: 0.0,
-        models: run
-            .models
-            .iter()
-            .map(|(d, ex)| ex.extract(d, Some(&run.motion)))
-            .collect(),
-    };
-    let _ = out.send(SimMessage::Started {
-        generation,
-        config: Box::new(config.clone()),
-        duration: run.duration,
-        labels,
-        exact: run.exact.take().map(Box::new),
-        first: Box::new(first),
-    });
+    let mut samples = run.initial_samples();
+    let _ = out.send(run.started_message(generation, config));
     let mut batch = Vec::new();
     let mut last_send = Instant::now();
     let (mut extract_total, mut extracted) = (0.0, 0u64);
@@ -374,24 +533,15 @@ fn run_one(
             Err(TryRecvError::Empty) => {}
         }
         let target = next_frame.min(run.duration);
-        for (dda, _) in run.models.iter_mut() {
-            if let Err(e) = dda.run_until(target, |_, _| {}) {
-                let _ = out.send(SimMessage::Failed {
-                    generation,
-                    message: e.to_string(),
-                });
-                return RunEnd::Failed;
-            }
+        if let Err(e) = run.advance_to(target, &mut samples) {
+            let _ = out.send(SimMessage::Failed {
+                generation,
+                message: e.to_string(),
+            });
+            return RunEnd::Failed;
         }
         let t_extract = Instant::now();
-        batch.push(FrameSet {
-            time: target,
-            models: run
-                .models
-                .iter()
-                .map(|(d, ex)| ex.extract(d, Some(&run.motion)))
-                .collect(),
-        });
+        batch.push(run.frame_set());
         extract_total += t_extract.elapsed().as_secs_f64();
         extracted += 1;
         next_frame += config.frame_dt;
@@ -400,10 +550,12 @@ fn run_one(
             let speed = target / start.elapsed().as_secs_f64().max(1e-9);
             let extract_us = 1e6 * extract_total / extracted.max(1) as f64;
             let frames = std::mem::take(&mut batch);
+            let fresh = samples.iter_mut().map(std::mem::take).collect();
             if out
                 .send(SimMessage::Frames {
                     generation,
                     frames,
+                    samples: fresh,
                     speed,
                     extract_us,
                 })

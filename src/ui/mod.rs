@@ -1,14 +1,29 @@
-//! The egui side of the visualizer: the controls, the timeline, the plots and the overlay
-//! labels, around a central area where the wgpu renderer draws the scene. All state lives
-//! in [`AppState`], which knows nothing about windows: it takes simulation messages in and
-//! gives commands out, so its logic can be tested with a bare `egui::Context`.
+//! The egui side of the visualizer: the controls, the timeline, the plots and the scene
+//! with its overlays. All state lives in [`AppState`], which knows nothing about windows:
+//! it takes simulation messages in and gives commands out (and requests such as
+//! "screenshot" or "quit" to the shell), so its logic is tested with egui_kittest and no
+//! window.
+//!
+//! Layout: a top bar (presets, the headline result, buttons), the controls on the left, the
+//! plots on the right, the timeline at the bottom and the scene in the middle. Panels
+//! collapse (and start collapsed in small windows); the full-screen scene mode hides them.
 
+mod controls;
+mod help;
 mod plots;
+pub mod presets;
+pub mod scene;
+mod timeline;
+
+use std::time::Instant;
 
 use crate::dda::Integrator;
-use crate::ground_motion::STANDARD_GRAVITY;
-use crate::render::{ColorBy, Layers};
-use crate::sim::{ExactOverlay, Excitation, FrameSet, SimCommand, SimConfig, SimMessage};
+use crate::render::{Camera, ColorBy, Fit, Layers};
+use crate::sim::{
+    ExactOverlay, Excitation, FrameSet, MotionInfo, Samples, SimCommand, SimConfig, SimMessage,
+};
+
+pub use plots::{Curve, MODEL_COLORS, PlotData, model_color, spectrum_of, write_plot_data};
 
 /// The scenes offered in the panel.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,18 +32,43 @@ pub enum SceneChoice {
     ThreeStorey,
     /// The paper's two-mass model (Fig. 2).
     TwoBlock,
+    /// The paper's frame with N storeys (`frame:N`).
+    Frame(u32),
+    /// A dry-stacked wall of N courses on a sliding slab (`wall:N`).
+    Wall(u32),
     /// A scene file.
     File(String),
 }
 
 impl SceneChoice {
-    fn name(&self) -> String {
+    /// The scene name the simulation understands.
+    pub fn name(&self) -> String {
         match self {
             SceneChoice::ThreeStorey => "three-storey".into(),
             SceneChoice::TwoBlock => "two-block".into(),
+            SceneChoice::Frame(n) => format!("frame:{n}"),
+            SceneChoice::Wall(n) => format!("wall:{n}"),
             SceneChoice::File(p) => p.clone(),
         }
     }
+
+    /// A label for people.
+    pub fn label(&self) -> String {
+        match self {
+            SceneChoice::ThreeStorey => "three-storey frame (paper Fig. 3)".into(),
+            SceneChoice::TwoBlock => "two-mass model (paper Fig. 2)".into(),
+            SceneChoice::Frame(n) => format!("frame of {n} storeys"),
+            SceneChoice::Wall(n) => format!("dry-stacked wall, {n} courses"),
+            SceneChoice::File(p) => file_name(p),
+        }
+    }
+}
+
+/// The last component of a path (long paths are shown by their file name).
+pub fn file_name(path: &str) -> String {
+    std::path::Path::new(path)
+        .file_name()
+        .map_or_else(|| path.to_string(), |n| n.to_string_lossy().into_owned())
 }
 
 /// The ground motions offered in the panel.
@@ -42,7 +82,21 @@ pub enum RecordChoice {
     File(String),
 }
 
-/// What the user has set in the panel (applied with a restart).
+/// What the model is compared with, side by side.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Comparison {
+    /// Nothing: the sliding model alone.
+    None,
+    /// The same structure with its base fixed to the ground.
+    FixedBase,
+    /// The sliding model with other friction coefficients.
+    Friction(Vec<f64>),
+    /// Other friction coefficients and the fixed base.
+    FrictionAndFixed(Vec<f64>),
+}
+
+/// What the user has set in the panel: the physics of a run. Any change restarts the run
+/// (keeping the time cursor); view settings and text being typed are elsewhere.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Controls {
     /// Scene.
@@ -53,6 +107,8 @@ pub struct Controls {
     pub amplitude_g: f64,
     /// Harmonic frequency: Ω/ω for the two-block scene, Hz otherwise.
     pub frequency: f64,
+    /// Scale the record to this peak ground acceleration, g (None: as recorded).
+    pub pga_g: Option<f64>,
     /// Friction coefficient of the sliding joint.
     pub friction: f64,
     /// Mass ratio α (two-block scene).
@@ -61,10 +117,8 @@ pub struct Controls {
     pub integrator: Integrator,
     /// Time step, s.
     pub dt: f64,
-    /// Run the fixed-base comparison beside the sliding model.
-    pub compare_fixed: bool,
-    /// Path typed in the file field.
-    pub path_input: String,
+    /// What runs beside the model.
+    pub comparison: Comparison,
 }
 
 impl Default for Controls {
@@ -74,12 +128,12 @@ impl Default for Controls {
             record: RecordChoice::Builtin("el-centro".into()),
             amplitude_g: 0.3,
             frequency: 1.0,
+            pga_g: None,
             friction: 0.01,
             alpha: 0.5,
             integrator: Integrator::default(),
             dt: 1e-3,
-            compare_fixed: true,
-            path_input: String::new(),
+            comparison: Comparison::FixedBase,
         }
     }
 }
@@ -88,6 +142,12 @@ impl Controls {
     /// The simulation configuration these controls describe.
     pub fn config(&self) -> SimConfig {
         let two_block = self.scene == SceneChoice::TwoBlock;
+        let (compare_friction, compare_fixed) = match &self.comparison {
+            Comparison::None => (Vec::new(), false),
+            Comparison::FixedBase => (Vec::new(), true),
+            Comparison::Friction(f) => (f.clone(), false),
+            Comparison::FrictionAndFixed(f) => (f.clone(), true),
+        };
         SimConfig {
             scene: self.scene.name(),
             friction: Some(self.friction),
@@ -102,7 +162,12 @@ impl Controls {
             },
             integrator: self.integrator,
             dt: self.dt,
-            compare_fixed: self.compare_fixed,
+            compare_fixed,
+            compare_friction,
+            pga_g: match self.record {
+                RecordChoice::Harmonic => None,
+                _ => self.pga_g,
+            },
             duration: None,
             ..SimConfig::default()
         }
@@ -118,10 +183,14 @@ pub struct Timeline {
     pub labels: Vec<String>,
     /// All frames so far, in time order.
     pub frames: Vec<FrameSet>,
+    /// Full-rate samples so far, one set per model.
+    pub samples: Vec<Samples>,
     /// Duration of the run, s.
     pub duration: f64,
     /// Exact mass-spring overlay (two-block).
     pub exact: Option<ExactOverlay>,
+    /// The ground motion as run.
+    pub motion: MotionInfo,
     /// Simulated seconds per wall second.
     pub sim_speed: f64,
     /// The run reached its end.
@@ -144,12 +213,101 @@ impl Timeline {
         let k = self.frames.partition_point(|f| f.time <= t + 1e-9);
         Some(k.saturating_sub(1))
     }
+
+    /// Simulated time between frames, s.
+    pub fn frame_dt(&self) -> f64 {
+        self.config.as_ref().map_or(0.01, |c| c.frame_dt)
+    }
+
+    /// Largest |value| of a sample column of model `m` up to time `t`.
+    pub fn peak(&self, m: usize, t: f64, column: fn(&Samples) -> &Vec<f64>) -> f64 {
+        self.samples.get(m).map_or(0.0, |s| {
+            column(s)[..s.count_until(t)]
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()))
+        })
+    }
+}
+
+/// How much deformation is magnified.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exaggeration {
+    /// Chosen so that the largest drift of the run is drawn as ~8 % of the height.
+    Auto,
+    /// This factor.
+    Fixed(f32),
+}
+
+/// What the user has set about the view (changing it never restarts a run).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSettings {
+    /// Layers drawn.
+    pub layers: Layers,
+    /// Deformation exaggeration.
+    pub exaggeration: Exaggeration,
+    /// Block colouring.
+    pub color_by: ColorBy,
+    /// The camera of the model panels.
+    pub camera: Camera,
+    /// Show the joint close-ups.
+    pub close_ups: bool,
+    /// Full-screen scene mode (panels hidden).
+    pub full_screen: bool,
+    /// Show the controls panel.
+    pub show_controls: bool,
+    /// Show the plots panel.
+    pub show_plots: bool,
+    /// The keyboard shortcuts overlay.
+    pub show_help: bool,
+    /// The "what am I looking at" window.
+    pub show_about: bool,
+    /// Developer diagnostics in the controls panel.
+    pub show_diagnostics: bool,
+    /// Spectra of the samples up to the time cursor (else of the whole run computed).
+    pub spectrum_to_cursor: bool,
+    /// Dark theme (else light, for projectors).
+    pub dark: bool,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        Self {
+            layers: Layers::default(),
+            exaggeration: Exaggeration::Auto,
+            color_by: ColorBy::Strain,
+            camera: Camera::default(),
+            close_ups: true,
+            full_screen: false,
+            show_controls: true,
+            show_plots: true,
+            show_help: false,
+            show_about: false,
+            show_diagnostics: false,
+            spectrum_to_cursor: false,
+            dark: false,
+        }
+    }
+}
+
+/// Something only the window shell can do, asked for by the UI.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ShellRequest {
+    /// Save a screenshot of the window to this PNG file.
+    Screenshot(std::path::PathBuf),
+    /// Close the window.
+    Quit,
+    /// Enter or leave the window's full-screen state.
+    FullScreen(bool),
 }
 
 /// The whole visualizer state.
 pub struct AppState {
-    /// Panel controls.
+    /// Panel controls (the physics).
     pub controls: Controls,
+    /// The path typed in the file field (loaded only with "load").
+    pub path_input: String,
+    /// View settings.
+    pub view: ViewSettings,
     /// What the simulation published.
     pub timeline: Timeline,
     /// Time shown, s.
@@ -160,23 +318,29 @@ pub struct AppState {
     pub speed: f64,
     /// Start again at the end.
     pub looping: bool,
-    /// Layers drawn.
-    pub layers: Layers,
-    /// Deformation exaggeration.
-    pub exaggeration: f32,
-    /// Block colouring.
-    pub color_by: ColorBy,
+    /// After a parameter change: the time the cursor returns to once the new run has
+    /// computed it.
+    pub resume_at: Option<f64>,
     /// Errors to show (bad file, solver stopped…).
     pub error: Option<String>,
+    /// A short message (file saved…), with when it was posted.
+    pub status: Option<(String, Instant)>,
+    /// Folder exports are written to.
+    pub export_dir: String,
     /// Smoothed frame time, ms.
     pub frame_ms: f64,
     /// Time to take in one batch of frames from the channel, µs (the state hand-off).
     pub handoff_us: f64,
     /// Mean time the simulation thread takes to copy a frame out of the solvers, µs.
     pub extract_us: f64,
-    /// Where the named widgets were last drawn (for tests and automation that click them).
+    /// Where the named widgets were last drawn (for automation that clicks them).
     pub widget_rects: std::collections::HashMap<&'static str, egui::Rect>,
+    /// The preset last chosen (its name), until the controls change.
+    pub preset: Option<&'static str>,
+    fits: Option<(u64, usize, f32, Vec<Fit>)>,
+    laid_out: bool,
     outbox: Vec<SimCommand>,
+    requests: Vec<ShellRequest>,
 }
 
 impl Default for AppState {
@@ -190,28 +354,38 @@ impl AppState {
     pub fn new(controls: Controls) -> Self {
         let mut s = Self {
             controls,
+            path_input: String::new(),
+            view: ViewSettings::default(),
             timeline: Timeline::default(),
             play_time: 0.0,
             playing: true,
             speed: 1.0,
             looping: true,
-            layers: Layers::default(),
-            exaggeration: 50.0,
-            color_by: ColorBy::Strain,
+            resume_at: None,
             error: None,
+            status: None,
+            export_dir: "slidebase-export".into(),
             frame_ms: 0.0,
             handoff_us: 0.0,
             extract_us: 0.0,
             widget_rects: Default::default(),
+            preset: None,
+            fits: None,
+            laid_out: false,
             outbox: Vec::new(),
+            requests: Vec::new(),
         };
         s.restart();
         s
     }
 
-    /// Queues a run with the current controls (from t = 0, in the background).
+    /// Queues a run with the current controls, in the background. The time cursor stays
+    /// where it is: the new run is shown there as soon as it has been computed that far.
     pub fn restart(&mut self) {
         self.error = None;
+        if self.timeline.generation > 0 {
+            self.resume_at = Some(self.play_time);
+        }
         self.outbox
             .push(SimCommand::Run(Box::new(self.controls.config())));
     }
@@ -221,64 +395,123 @@ impl AppState {
         std::mem::take(&mut self.outbox)
     }
 
+    /// Requests for the window shell since the last call.
+    pub fn take_requests(&mut self) -> Vec<ShellRequest> {
+        std::mem::take(&mut self.requests)
+    }
+
+    /// Posts a short message in the top bar.
+    pub fn say(&mut self, message: impl Into<String>) {
+        self.status = Some((message.into(), Instant::now()));
+    }
+
     /// Takes in a message from the simulation thread.
     pub fn ingest(&mut self, msg: SimMessage) {
-        let t0 = std::time::Instant::now();
+        let t0 = Instant::now();
         match msg {
             SimMessage::Started {
                 generation,
                 config,
                 duration,
                 labels,
+                motion,
                 exact,
                 first,
             } => {
+                let models = first.models.len();
                 self.timeline = Timeline {
                     generation,
                     labels,
                     frames: vec![*first],
+                    samples: vec![Samples::default(); models],
                     duration,
                     exact: exact.map(|e| *e),
+                    motion: *motion,
                     sim_speed: 0.0,
                     finished: false,
                     config: Some(*config),
                 };
-                self.play_time = 0.0;
+                self.play_time = match self.resume_at {
+                    Some(t) => t.min(duration),
+                    None => 0.0,
+                };
+                self.fits = None;
             }
             SimMessage::Frames {
                 generation,
                 frames,
+                mut samples,
                 speed,
                 extract_us,
             } if generation == self.timeline.generation => {
                 self.timeline.frames.extend(frames);
+                for (mine, new) in self.timeline.samples.iter_mut().zip(samples.iter_mut()) {
+                    mine.append(new);
+                }
                 self.timeline.sim_speed = speed;
                 self.extract_us = extract_us;
                 self.handoff_us = 0.9 * self.handoff_us + 0.1 * t0.elapsed().as_secs_f64() * 1e6;
+                if let Some(t) = self.resume_at
+                    && self.timeline.available() >= t.min(self.timeline.duration) - 1e-9
+                {
+                    self.resume_at = None;
+                }
             }
             SimMessage::Finished { generation, .. } if generation == self.timeline.generation => {
                 self.timeline.finished = true;
+                self.resume_at = None;
             }
-            SimMessage::Failed { message, .. } => self.error = Some(message),
+            SimMessage::Failed { message, .. } => {
+                self.error = Some(message);
+                self.resume_at = None;
+            }
             _ => {}
         }
+    }
+
+    /// Whether the picture changes without input: playing, or a run still computing.
+    pub fn animating(&self) -> bool {
+        (self.playing && !self.at_end()) || !self.timeline.finished
+    }
+
+    fn at_end(&self) -> bool {
+        self.timeline.finished && self.play_time >= self.timeline.duration - 1e-9
     }
 
     /// Advances the playback clock by `wall_dt` seconds of wall time.
     pub fn advance(&mut self, wall_dt: f64) {
         self.frame_ms = 0.9 * self.frame_ms + 0.1 * wall_dt * 1e3;
-        if !self.playing {
+        if !self.playing || self.resume_at.is_some() {
             return;
         }
         let available = self.timeline.available();
         self.play_time += wall_dt * self.speed;
-        if self.play_time >= self.timeline.duration - 1e-9 && self.timeline.finished && self.looping
-        {
-            self.play_time = 0.0;
+        if self.play_time >= self.timeline.duration - 1e-9 && self.timeline.finished {
+            if self.looping {
+                self.play_time = 0.0;
+            } else {
+                self.play_time = self.timeline.duration;
+                self.playing = false;
+            }
         } else if self.play_time > available {
-            // Wait for the simulation (it runs ahead in real time on this machine).
+            // Wait for the simulation (it runs ahead of real time on this machine).
             self.play_time = available;
         }
+    }
+
+    /// Starts or pauses playback; play at the end starts again from the beginning.
+    pub fn toggle_play(&mut self) {
+        if !self.playing && self.at_end() {
+            self.play_time = 0.0;
+        }
+        self.playing = !self.playing;
+    }
+
+    /// Moves the time cursor to `t` (clamped to what has been computed) and pauses.
+    pub fn seek(&mut self, t: f64) {
+        self.play_time = t.clamp(0.0, self.timeline.available());
+        self.resume_at = None;
+        self.playing = false;
     }
 
     /// The frame shown now.
@@ -294,7 +527,16 @@ impl AppState {
             let k = (k as i64 + frames).clamp(0, self.timeline.frames.len() as i64 - 1) as usize;
             self.play_time = self.timeline.frames[k].time;
         }
+        self.resume_at = None;
         self.playing = false;
+    }
+
+    /// The exaggeration factor in force.
+    pub fn exaggeration(&self) -> f32 {
+        match self.view.exaggeration {
+            Exaggeration::Fixed(f) => f,
+            Exaggeration::Auto => auto_exaggeration(&self.timeline),
+        }
     }
 
     /// Largest colour measure over all frames so far (a stable colour scale).
@@ -304,7 +546,7 @@ impl AppState {
             for model in &f.models {
                 for b in model.blocks.iter().filter(|b| !b.is_ground) {
                     m = m.max(crate::render::geometry::color_measure(
-                        self.color_by,
+                        self.view.color_by,
                         &b.stress,
                         &b.strain,
                     ));
@@ -314,222 +556,154 @@ impl AppState {
         m
     }
 
-    /// Draws the whole UI; returns the rectangle (in points) left for the scene.
-    pub fn ui(&mut self, ui: &mut egui::Ui) -> egui::Rect {
+    /// The boxes that frame the models (as drawn with the current exaggeration), over all
+    /// frames computed when first asked; `refit` recomputes them over all frames now.
+    pub fn fits(&mut self, refit: bool) -> Vec<Fit> {
+        let f = self.exaggeration();
+        let key = (self.timeline.generation, f);
+        let stale = match &self.fits {
+            Some((g, n, e, _)) => {
+                refit
+                    || (*g, *e) != key
+                    // Until the run has a few seconds, keep taking the new frames in.
+                    || (*n < 400 && self.timeline.frames.len() > *n + 25)
+            }
+            None => true,
+        };
+        if stale {
+            let models = self.timeline.frames.first().map_or(0, |f| f.models.len());
+            let fits = (0..models)
+                .map(|m| {
+                    Fit::of_frames(
+                        self.timeline
+                            .frames
+                            .iter()
+                            .filter_map(|fs| fs.models.get(m)),
+                        f,
+                    )
+                })
+                .collect();
+            self.fits = Some((key.0, self.timeline.frames.len(), key.1, fits));
+        }
+        self.fits.as_ref().map(|x| x.3.clone()).unwrap_or_default()
+    }
+
+    /// Draws the whole UI.
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        if !self.laid_out {
+            // A small window starts with the controls folded away: the scene needs the room.
+            self.laid_out = true;
+            if ui.ctx().content_rect().width() < 1280.0 {
+                self.view.show_controls = false;
+            }
+        }
         self.keyboard(ui.ctx());
-        egui::Panel::left("controls")
-            .resizable(true)
-            .default_size(290.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| self.controls_ui(ui));
-            });
+        let full = self.view.full_screen;
+        if !full {
+            egui::Panel::top("top").show(ui, |ui| self.top_bar(ui));
+        }
         egui::Panel::bottom("timeline").show(ui, |ui| self.timeline_ui(ui));
-        egui::Panel::right("plots")
-            .resizable(true)
-            .default_size(460.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| plots::plots_ui(self, ui));
-            });
-        let response = egui::CentralPanel::default()
+        let width = ui.ctx().content_rect().width();
+        if !full && self.view.show_controls {
+            egui::Panel::left("controls")
+                .resizable(true)
+                .default_size((0.2 * width).clamp(230.0, 300.0))
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| self.controls_ui(ui));
+                });
+        }
+        if !full && self.view.show_plots {
+            egui::Panel::right("plots")
+                .resizable(true)
+                .default_size((0.3 * width).clamp(300.0, 620.0))
+                .show(ui, |ui| {
+                    // Not shrunk to the content: with every plot folded the panel kept
+                    // shrinking, and unfolding them then gave plots 150 px wide.
+                    egui::ScrollArea::vertical()
+                        .auto_shrink([false, false])
+                        .show(ui, |ui| plots::plots_ui(self, ui));
+                });
+        }
+        egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
-            .show(ui, |ui| {
-                let rect = ui.max_rect();
-                self.overlay(ui, rect);
-                rect
-            });
-        response.inner
+            .show(ui, |ui| scene::scene_ui(self, ui));
+        help::windows(self, ui.ctx());
     }
 
     fn keyboard(&mut self, ctx: &egui::Context) {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
-        let (space, left, right, home) = ctx.input(|i| {
-            (
-                i.key_pressed(egui::Key::Space),
-                i.key_pressed(egui::Key::ArrowLeft),
-                i.key_pressed(egui::Key::ArrowRight),
-                i.key_pressed(egui::Key::Home),
-            )
+        // Every key press counts, also several in one frame (fast tapping).
+        let mut keys = Vec::new();
+        let mut question = false;
+        ctx.input(|i| {
+            for e in &i.events {
+                match e {
+                    egui::Event::Key {
+                        key,
+                        pressed: true,
+                        modifiers,
+                        ..
+                    } => keys.push((*key, *modifiers)),
+                    egui::Event::Text(t) if t == "?" => question = true,
+                    _ => {}
+                }
+            }
         });
-        if space {
-            self.playing = !self.playing;
+        if question {
+            self.view.show_help = !self.view.show_help;
         }
-        if left {
-            self.step_frames(-1);
-        }
-        if right {
-            self.step_frames(1);
-        }
-        if home {
-            self.play_time = 0.0;
+        let second = (1.0 / self.timeline.frame_dt()).round() as i64;
+        for (key, m) in keys {
+            use egui::Key;
+            match key {
+                Key::Space => self.toggle_play(),
+                Key::ArrowLeft if m.shift => self.step_frames(-second),
+                Key::ArrowRight if m.shift => self.step_frames(second),
+                Key::ArrowLeft => self.step_frames(-1),
+                Key::ArrowRight => self.step_frames(1),
+                Key::Home => self.seek(0.0),
+                Key::End => self.seek(self.timeline.available()),
+                Key::F if !m.command => self.view.camera.fit(),
+                Key::H if !m.command => self.view.show_help = !self.view.show_help,
+                Key::Q if m.command => self.requests.push(ShellRequest::Quit),
+                Key::F11 => self.set_full_screen(!self.view.full_screen),
+                Key::Escape => {
+                    if self.view.show_help || self.view.show_about {
+                        self.view.show_help = false;
+                        self.view.show_about = false;
+                    } else if self.view.full_screen {
+                        self.set_full_screen(false);
+                    }
+                }
+                _ => {}
+            }
         }
     }
 
-    fn controls_ui(&mut self, ui: &mut egui::Ui) {
-        let before = self.controls.clone();
-        ui.heading("slidebase");
-        ui.label("A building on a sliding (friction) base under an earthquake, computed with DDA.");
-        ui.separator();
-        egui::ComboBox::from_label("scene")
-            .selected_text(match &self.controls.scene {
-                SceneChoice::ThreeStorey => "three-storey frame".to_string(),
-                SceneChoice::TwoBlock => "two-block (paper Fig. 2)".to_string(),
-                SceneChoice::File(p) => p.clone(),
-            })
-            .show_ui(ui, |ui| {
-                ui.selectable_value(
-                    &mut self.controls.scene,
-                    SceneChoice::ThreeStorey,
-                    "three-storey frame",
-                );
-                ui.selectable_value(
-                    &mut self.controls.scene,
-                    SceneChoice::TwoBlock,
-                    "two-block (paper Fig. 2)",
-                );
-            });
-        let record_text = match &self.controls.record {
-            RecordChoice::Builtin(n) => n.clone(),
-            RecordChoice::Harmonic => "harmonic".into(),
-            RecordChoice::File(p) => p.clone(),
-        };
-        egui::ComboBox::from_label("ground motion")
-            .selected_text(record_text)
-            .show_ui(ui, |ui| {
-                for name in crate::ground_motion::builtin_names() {
-                    ui.selectable_value(
-                        &mut self.controls.record,
-                        RecordChoice::Builtin(name.to_string()),
-                        name,
-                    );
-                }
-                ui.selectable_value(
-                    &mut self.controls.record,
-                    RecordChoice::Harmonic,
-                    "harmonic",
-                );
-            });
-        if self.controls.record == RecordChoice::Harmonic {
-            ui.add(
-                egui::Slider::new(&mut self.controls.amplitude_g, 0.01..=1.5).text("amplitude (g)"),
-            );
-            let label = if self.controls.scene == SceneChoice::TwoBlock {
-                "Ω/ω"
-            } else {
-                "frequency (Hz)"
-            };
-            ui.add(
-                egui::Slider::new(&mut self.controls.frequency, 0.1..=10.0)
-                    .logarithmic(true)
-                    .text(label),
-            );
-        }
-        ui.horizontal(|ui| {
-            ui.add(
-                egui::TextEdit::singleline(&mut self.controls.path_input)
-                    .hint_text("AT2/CSV record or TOML scene")
-                    .desired_width(170.0),
-            );
-            let load = ui.button("load");
-            self.widget_rects.insert("load", load.rect);
-            if load.clicked() {
-                self.load_path();
-            }
-        });
-        ui.separator();
-        let r = ui.add(
-            egui::Slider::new(&mut self.controls.friction, 0.0..=1.0)
-                .logarithmic(true)
-                .smallest_positive(0.001)
-                .text("friction ρ"),
-        );
-        self.widget_rects.insert("friction", r.rect);
-        if self.controls.scene == SceneChoice::TwoBlock {
-            ui.add(egui::Slider::new(&mut self.controls.alpha, 0.05..=0.95).text("mass ratio α"));
-        }
-        egui::ComboBox::from_label("integrator")
-            .selected_text(self.controls.integrator.label())
-            .show_ui(ui, |ui| {
-                ui.selectable_value(
-                    &mut self.controls.integrator,
-                    Integrator::default(),
-                    "generalized-alpha (ρ∞ = 0)",
-                );
-                ui.selectable_value(
-                    &mut self.controls.integrator,
-                    Integrator::Trapezoidal,
-                    "trapezoidal",
-                );
-                ui.selectable_value(
-                    &mut self.controls.integrator,
-                    Integrator::Classic,
-                    "classic DDA (the paper's)",
-                );
-            });
-        ui.add(
-            egui::Slider::new(&mut self.controls.dt, 1e-4..=1e-2)
-                .logarithmic(true)
-                .text("Δt (s)"),
-        );
-        ui.checkbox(&mut self.controls.compare_fixed, "fixed-base comparison");
-        if self.controls != before {
-            // Any change of the physics restarts the run from t = 0, in the background.
-            self.restart();
-        }
-        ui.separator();
-        ui.label("view");
-        ui.add(
-            egui::Slider::new(&mut self.exaggeration, 1.0..=1000.0)
-                .logarithmic(true)
-                .text("exaggeration ×"),
-        );
-        egui::ComboBox::from_label("colour")
-            .selected_text(format!("{:?}", self.color_by).to_lowercase())
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut self.color_by, ColorBy::Strain, "strain (this run)");
-                ui.selectable_value(&mut self.color_by, ColorBy::Stress, "stress (with gravity)");
-                ui.selectable_value(&mut self.color_by, ColorBy::Material, "material");
-            });
-        let l = &mut self.layers;
-        ui.horizontal_wrapped(|ui| {
-            ui.checkbox(&mut l.blocks, "blocks");
-            ui.checkbox(&mut l.outlines, "outlines");
-            ui.checkbox(&mut l.contacts, "contact springs");
-            ui.checkbox(&mut l.slip, "slip");
-            ui.checkbox(&mut l.bolts, "bolts");
-            ui.checkbox(&mut l.connections, "connections");
-            ui.checkbox(&mut l.ground, "ground");
-        });
-        ui.separator();
-        ui.label(format!(
-            "simulation: {:.1}× real time{}",
-            self.timeline.sim_speed,
-            if self.timeline.finished {
-                " (done)"
-            } else {
-                ""
-            }
+    /// Enters or leaves the full-screen scene mode.
+    pub fn set_full_screen(&mut self, on: bool) {
+        self.view.full_screen = on;
+        self.requests.push(ShellRequest::FullScreen(on));
+    }
+
+    /// Asks the shell for a screenshot of the window into the export folder.
+    pub fn request_screenshot(&mut self) {
+        let path = std::path::Path::new(&self.export_dir).join(format!(
+            "slidebase-t{:06.2}s-{}.png",
+            self.play_time,
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs())
         ));
-        ui.label(format!(
-            "frame time: {:.1} ms ({:.0} fps)",
-            self.frame_ms,
-            1000.0 / self.frame_ms.max(1e-3)
-        ));
-        ui.label(format!(
-            "state hand-off: {:.0} µs to copy a frame out, {:.1} µs to take a batch in",
-            self.extract_us, self.handoff_us
-        ));
-        if let Some(e) = &self.error {
-            ui.separator();
-            ui.colored_label(egui::Color32::from_rgb(200, 30, 30), e);
-        }
+        self.requests.push(ShellRequest::Screenshot(path));
     }
 
     /// Loads the path typed in the file field: a TOML scene or a record file. Errors are
     /// shown in the panel; nothing crashes.
     pub fn load_path(&mut self) {
-        let path = self.controls.path_input.trim().to_string();
+        let path = self.path_input.trim().to_string();
         if path.is_empty() {
             self.error = Some("type the path of an AT2/CSV record or a TOML scene first".into());
             return;
@@ -553,177 +727,63 @@ impl AppState {
         }
     }
 
-    fn timeline_ui(&mut self, ui: &mut egui::Ui) {
-        ui.horizontal(|ui| {
-            if ui
-                .button(if self.playing { "pause" } else { "play" })
-                .clicked()
-            {
-                self.playing = !self.playing;
-            }
-            if ui.button("|<").on_hover_text("start (Home)").clicked() {
-                self.play_time = 0.0;
-            }
-            if ui
-                .button("<")
-                .on_hover_text("one frame back (left arrow)")
-                .clicked()
-            {
-                self.step_frames(-1);
-            }
-            if ui
-                .button(">")
-                .on_hover_text("one frame on (right arrow)")
-                .clicked()
-            {
-                self.step_frames(1);
-            }
-            let max = self.timeline.duration.max(1e-3);
-            let available = self.timeline.available();
-            let mut t = self.play_time;
-            let slider = egui::Slider::new(&mut t, 0.0..=max)
-                .text("t (s)")
-                .fixed_decimals(2);
-            let r = ui.add_sized([ui.available_width() * 0.55, 20.0], slider);
-            self.widget_rects.insert("time", r.rect);
-            // Only the user moves the cursor: the slider also reports a change when it
-            // rounds the playing time to its two decimals, which must not pause playback.
-            let by_user = r.dragged() || r.drag_stopped() || r.clicked() || r.has_focus();
-            if r.changed() && by_user {
-                self.play_time = t.min(available);
-                self.playing = false;
-            }
-            egui::ComboBox::from_id_salt("speed")
-                .selected_text(format!("{}×", self.speed))
-                .width(60.0)
-                .show_ui(ui, |ui| {
-                    for s in [0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0] {
-                        ui.selectable_value(&mut self.speed, s, format!("{s}×"));
-                    }
-                });
-            ui.checkbox(&mut self.looping, "loop");
-            ui.label(format!("computed to {available:.1} / {max:.1} s"));
-        });
-    }
-
-    /// Labels over the scene: panel names, time, peak values and the colour scale.
-    fn overlay(&self, ui: &mut egui::Ui, rect: egui::Rect) {
-        let Some(frame) = self.current() else {
-            ui.painter().text(
-                rect.center(),
-                egui::Align2::CENTER_CENTER,
-                "starting…",
-                egui::FontId::proportional(18.0),
-                egui::Color32::DARK_GRAY,
-            );
-            return;
-        };
-        let n = frame.models.len().max(1) as f32;
-        let stacked = crate::render::offscreen::stack_vertically(
-            rect.width(),
-            rect.height(),
-            frame.models.len(),
-        );
-        let (w, hgt) = if stacked {
-            (rect.width(), rect.height() / n)
-        } else {
-            (rect.width() / n, rect.height())
-        };
-        let painter = ui.painter_at(rect);
-        for (k, model) in frame.models.iter().enumerate() {
-            let label = self.timeline.labels.get(k).cloned().unwrap_or_default();
-            let (x0, y0) = if stacked {
-                (rect.left(), rect.top() + k as f32 * hgt)
-            } else {
-                (rect.left() + k as f32 * w, rect.top())
-            };
-            let text = format!(
-                "{label}\nroof {:+.3} g   base {:+.3} g   slip {:+.3} m   drift {:+.4} m",
-                model.probes.roof_accel / STANDARD_GRAVITY,
-                model.probes.base_accel / STANDARD_GRAVITY,
-                model.probes.slip,
-                model.probes.drift
-            );
-            painter.text(
-                egui::pos2(x0 + 10.0, y0 + 8.0),
-                egui::Align2::LEFT_TOP,
-                text,
-                egui::FontId::proportional(14.0),
-                egui::Color32::from_gray(30),
-            );
-            if k > 0 {
-                let line = if stacked {
-                    [egui::pos2(rect.left(), y0), egui::pos2(rect.right(), y0)]
-                } else {
-                    [egui::pos2(x0, rect.top()), egui::pos2(x0, rect.bottom())]
-                };
-                painter.line_segment(line, egui::Stroke::new(1.0, egui::Color32::from_gray(160)));
-            }
+    /// The headline comparison: the main model's peak roof acceleration against the
+    /// second model's, up to the time cursor ("−89 % against fixed base").
+    pub fn headline(&self) -> Option<(String, f64)> {
+        let labels = &self.timeline.labels;
+        if labels.len() < 2 {
+            return None;
         }
-        painter.text(
-            egui::pos2(rect.right() - 10.0, rect.bottom() - 10.0),
-            egui::Align2::RIGHT_BOTTOM,
+        let other = labels.len() - 1;
+        let t = self.play_time;
+        let main = self.timeline.peak(0, t, |s| &s.roof_accel);
+        let cmp = self.timeline.peak(other, t, |s| &s.roof_accel);
+        if cmp <= 0.0 {
+            return None;
+        }
+        let change = 100.0 * (main - cmp) / cmp;
+        let g = crate::ground_motion::STANDARD_GRAVITY;
+        Some((
             format!(
-                "t = {:.2} s   ground {:+.3} g   deformation ×{:.0}",
-                frame.time,
-                frame.models[0].probes.ground_accel / STANDARD_GRAVITY,
-                self.exaggeration
+                "peak roof acceleration {:.2} g against {:.2} g with the {}: {:+.0} %",
+                main / g,
+                cmp / g,
+                labels[other],
+                change
             ),
-            egui::FontId::proportional(14.0),
-            egui::Color32::from_gray(30),
-        );
-        // Colour scale.
-        if self.color_by != ColorBy::Material {
-            let bar = egui::Rect::from_min_size(
-                egui::pos2(rect.left() + 12.0, rect.bottom() - 34.0),
-                egui::vec2(160.0, 10.0),
-            );
-            for i in 0..32 {
-                let c = crate::render::geometry::colormap(i as f32 / 31.0);
-                let srgb = |v: f32| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8;
-                let r = egui::Rect::from_min_size(
-                    egui::pos2(bar.left() + i as f32 * 5.0, bar.top()),
-                    egui::vec2(5.0, 10.0),
-                );
-                painter.rect_filled(
-                    r,
-                    0.0,
-                    egui::Color32::from_rgb(srgb(c[0]), srgb(c[1]), srgb(c[2])),
-                );
-            }
-            let max = self.color_max();
-            let unit = match self.color_by {
-                ColorBy::Stress => format!("von Mises stress 0 … {:.2e} Pa", max),
-                _ => format!("strain 0 … {:.2e}", max),
-            };
-            painter.text(
-                egui::pos2(bar.left(), bar.bottom() + 3.0),
-                egui::Align2::LEFT_TOP,
-                unit,
-                egui::FontId::proportional(12.0),
-                egui::Color32::from_gray(30),
-            );
-        }
-        let legend = [
-            ("locked", crate::render::geometry::LOCKED),
-            ("sliding", crate::render::geometry::SLIDING),
-            ("open", crate::render::geometry::OPEN),
-        ];
-        for (i, (name, c)) in legend.iter().enumerate() {
-            let srgb = |v: f32| (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8;
-            let pos = egui::pos2(rect.left() + 190.0 + i as f32 * 70.0, rect.bottom() - 30.0);
-            painter.circle_filled(
-                pos,
-                5.0,
-                egui::Color32::from_rgb(srgb(c[0]), srgb(c[1]), srgb(c[2])),
-            );
-            painter.text(
-                pos + egui::vec2(8.0, 0.0),
-                egui::Align2::LEFT_CENTER,
-                *name,
-                egui::FontId::proportional(12.0),
-                egui::Color32::from_gray(30),
-            );
-        }
+            change,
+        ))
     }
+}
+
+/// The automatic exaggeration: the largest storey drift computed so far drawn as about
+/// 8 % of the structure's height, rounded down to 1, 2 or 5 × 10ⁿ, between 1 and 1000.
+pub fn auto_exaggeration(timeline: &Timeline) -> f32 {
+    let Some(first) = timeline.frames.first() else {
+        return 1.0;
+    };
+    let height = first
+        .models
+        .first()
+        .map_or(1.0, |m| {
+            m.blocks
+                .iter()
+                .filter(|b| !b.is_ground)
+                .flat_map(|b| b.vertices.iter().map(|v| v[1]))
+                .fold(0.0f32, f32::max)
+        })
+        .max(0.1);
+    let drift = (0..timeline.samples.len())
+        .map(|m| timeline.peak(m, f64::INFINITY, |s| &s.drift))
+        .fold(0.0f64, f64::max) as f32;
+    if drift.is_nan() || drift <= 0.0 {
+        return 50.0;
+    }
+    let raw = (0.08 * height / drift).clamp(1.0, 1000.0);
+    let p = 10f32.powf(raw.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * p)
+        .find(|&s| s <= raw)
+        .unwrap_or(p)
 }
