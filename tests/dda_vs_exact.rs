@@ -4,8 +4,9 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use slidebase::dda::Integrator;
+use slidebase::dda::{ContactEnforcement, Integrator, SolverParams};
 use slidebase::headless::run::run;
+use slidebase::headless::simulate::{ModelRun, run_dda, run_exact};
 use slidebase::headless::sweep::{SweepRequest, parse_ratios, run_sweep};
 use slidebase::post::sweep::error_table;
 use slidebase::setup::{ExcitationSpec, ModelKind, RunSpec};
@@ -155,25 +156,13 @@ fn frictionless_dda_raft_stays_put() {
     );
 }
 
-/// `restart_after_events = false` once spun forever at t ≈ 14.2 s of the default run (an
-/// event at a step's start asked for a restart that never came). Every step must end, and
-/// without restarts the run must still be the same physics: the slip within 2 % of the
-/// exact model's (the event resolution only sharpens the transitions).
-#[test]
-fn runs_without_event_restarts_finish_and_agree() {
-    use slidebase::dda::SolverParams;
-    use slidebase::headless::simulate::{run_dda, run_exact};
-    let setup = RunSpec {
-        duration: Some(20.0),
-        ..RunSpec::default()
-    }
-    .prepare()
-    .unwrap();
-    let params = SolverParams {
-        restart_after_events: false,
-        ..setup.solver_params()
-    };
-    let run = run_dda(&setup, &setup.scene, params).unwrap();
+/// The DDA run of `spec` with `params` adjusted, and the exact model of the same point.
+fn dda_and_exact(
+    spec: RunSpec,
+    adjust: impl FnOnce(SolverParams) -> SolverParams,
+) -> (ModelRun, ModelRun) {
+    let setup = spec.prepare().unwrap();
+    let run = run_dda(&setup, &setup.scene, adjust(setup.solver_params())).unwrap();
     let (roles, alpha, _) = setup.two_block().unwrap();
     let exact = run_exact(
         alpha,
@@ -185,11 +174,24 @@ fn runs_without_event_restarts_finish_and_agree() {
         0.0,
     )
     .unwrap();
-    assert!(
-        run.steps as f64 >= setup.duration / setup.dt,
-        "{} steps",
-        run.steps
-    );
+    (run, exact)
+}
+
+/// `restart_after_events = false` once spun forever at t ≈ 14.2 s of the default run (an
+/// event at a step's start asked for a restart that never came). Every step must end, and
+/// without restarts the run must still be the same physics: the slip within 2 % of the
+/// exact model's (the event resolution only sharpens the transitions).
+#[test]
+fn runs_without_event_restarts_finish_and_agree() {
+    let spec = RunSpec {
+        duration: Some(20.0),
+        ..RunSpec::default()
+    };
+    let (run, exact) = dda_and_exact(spec, |p| SolverParams {
+        restart_after_events: false,
+        ..p
+    });
+    assert!(run.steps >= 20_000, "{} steps", run.steps);
     let error = (run.peaks.slip_m - exact.peaks.slip_m).abs() / exact.peaks.slip_m;
     assert!(
         error < 0.02,
@@ -197,4 +199,40 @@ fn runs_without_event_restarts_finish_and_agree() {
         run.peaks.slip_m,
         exact.peaks.slip_m
     );
+}
+
+/// Issue 13, item 1: with penalty springs a stuck joint is an oscillator, and at Δt = 1e-4
+/// with the (non-dissipative) trapezoidal rule its ringing after every re-stick put
+/// a_base/a_g 30 % above the exact model's at (α 0.5, ρ 0.1, Ω/ω 2). With the augmented
+/// Lagrangian the stuck joint is an exact constraint: every peak within 0.5 % (the
+/// issue's p90 target), at the step size where the penalty method is worst.
+#[test]
+#[ignore = "1e-4 s steps: run in release (cargo test --release -- --ignored)"]
+fn augmented_lagrangian_contacts_do_not_ring_at_fine_steps() {
+    let spec = RunSpec {
+        alpha: Some(0.5),
+        friction: Some(0.1),
+        excitation: ExcitationSpec::ratio(2.0),
+        duration: Some(20.0),
+        dt: Some(1e-4),
+        integrator: Some(Integrator::Trapezoidal),
+        ..RunSpec::default()
+    };
+    let (run, exact) = dda_and_exact(spec, |p| SolverParams {
+        contact_enforcement: ContactEnforcement::AugmentedLagrangian,
+        ..p
+    });
+    let (p, e) = (&run.peaks, &exact.peaks);
+    for (name, dda, reference) in [
+        ("slip", p.slip_m, e.slip_m),
+        ("drift", p.drift_m, e.drift_m),
+        ("a_base", p.base_accel, e.base_accel),
+        ("a_roof", p.roof_accel, e.roof_accel),
+    ] {
+        let error = (dda - reference).abs() / reference.abs();
+        assert!(
+            error < 5e-3,
+            "{name}: {dda} vs exact {reference} (error {error:.1e})"
+        );
+    }
 }

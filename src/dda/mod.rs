@@ -11,6 +11,7 @@ pub mod assembly;
 pub mod block;
 pub mod contact;
 pub mod energy;
+pub mod integrator;
 pub mod joints;
 pub mod judge;
 pub mod linear;

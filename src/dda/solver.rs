@@ -744,7 +744,7 @@ impl Dda {
     ) {
         let c = &self.coeffs;
         let (mass_factor, stiffness_factor) = match mode {
-            Mode::Dynamic { dt } => ((1.0 - c.alpha_m) / (c.beta * dt * dt), 1.0 - c.alpha_f),
+            Mode::Dynamic { dt } => (c.mass_factor(dt), 1.0 - c.alpha_f),
             // A vanishing "mass spring" (1 mHz) only so that unloaded rigid-body modes (a
             // roof hung on one bolt can still turn) do not make the static matrix singular.
             Mode::Static { .. } => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
@@ -770,13 +770,10 @@ impl Dda {
             // Gravity.
             sys.r[s + 1] -= b.total_mass() * self.gravity;
             if let Mode::Dynamic { dt } = mode {
-                // Inertia from the previous step: −M[(1 − αm) ã + αm a], with
-                // ã = −v/(βΔt) − (1/(2β) − 1) a.
+                // Inertia from the previous step: −M[(1 − αm) ã + αm a].
                 let mut w = [0.0; 6];
                 for k in 0..6 {
-                    let a_tilde =
-                        -b.velocity[k] / (c.beta * dt) - (0.5 / c.beta - 1.0) * b.accel[k];
-                    w[k] = (1.0 - c.alpha_m) * a_tilde + c.alpha_m * b.accel[k];
+                    w[k] = c.inertia_predictor(b.velocity[k], b.accel[k], dt);
                 }
                 for i in 0..6 {
                     let mw: f64 = (0..6).map(|j| b.mass[i][j] * w[j]).sum();
@@ -904,25 +901,21 @@ impl Dda {
             if damping == 0.0 {
                 continue;
             }
-            // v_{n+1} = γ/(βΔt)·D + w, w = v(1 − γ/β) + Δt a(1 − γ/(2β)).
+            // v_{n+1} = γ/(βΔt)·D + w.
             let mut f0 = 0.0;
             let mut parts: Vec<(usize, &Vec6)> = Vec::with_capacity(2);
             for (blk, vec) in [(i, a), (j, b)] {
                 let bl = &self.blocks[blk];
-                match self.dofs.slot[blk] {
-                    Some(_) => {
-                        let mut w = [0.0; 6];
-                        for k in 0..6 {
-                            w[k] = bl.velocity[k] * (1.0 - co.gamma / co.beta)
-                                + dt * bl.accel[k] * (1.0 - co.gamma / (2.0 * co.beta));
-                        }
-                        f0 += damping
-                            * ((1.0 - co.alpha_f) * dot6(vec, &w)
-                                + co.alpha_f * dot6(vec, &bl.velocity));
-                        parts.push((blk, vec));
+                // The prescribed ground (no unknowns) stands still in the moving frame.
+                if self.dofs.slot[blk].is_some() {
+                    let mut w = [0.0; 6];
+                    for k in 0..6 {
+                        w[k] = co.velocity_predictor(bl.velocity[k], bl.accel[k], dt);
                     }
-                    // The prescribed ground stands still in the moving frame.
-                    None => {}
+                    f0 += damping
+                        * ((1.0 - co.alpha_f) * dot6(vec, &w)
+                            + co.alpha_f * dot6(vec, &bl.velocity));
+                    parts.push((blk, vec));
                 }
             }
             let k = damping * co.gamma / (co.beta * dt);
@@ -1258,11 +1251,8 @@ impl Dda {
                 _ => {
                     let mut v = [0.0; 6];
                     for k in 0..6 {
-                        let a_new = d[k] / (c.beta * dt * dt)
-                            - b.velocity[k] / (c.beta * dt)
-                            - (0.5 / c.beta - 1.0) * b.accel[k];
-                        v[k] =
-                            b.velocity[k] + dt * ((1.0 - c.gamma) * b.accel[k] + c.gamma * a_new);
+                        let a_new = c.end_accel(d[k], b.velocity[k], b.accel[k], dt);
+                        v[k] = c.end_velocity(b.velocity[k], b.accel[k], a_new, dt);
                     }
                     v
                 }
@@ -2013,30 +2003,19 @@ impl Dda {
             .map(|b| [b.velocity, b.response_accel])
             .collect();
         // Newmark update of velocities and accelerations.
-        for (bi, b) in self.blocks.iter_mut().enumerate() {
-            match b.role {
-                BlockRole::PrescribedGround => {
-                    b.velocity = [0.0; 6];
-                    b.accel = [0.0; 6];
-                    b.response_accel = [0.0; 6];
-                }
-                _ => {
-                    let d = &increments[bi];
-                    for k in 0..6 {
-                        let a_new = d[k] / (c.beta * dt * dt)
-                            - b.velocity[k] / (c.beta * dt)
-                            - (0.5 / c.beta - 1.0) * b.accel[k];
-                        b.velocity[k] += dt * ((1.0 - c.gamma) * b.accel[k] + c.gamma * a_new);
-                        // The step balanced the forces at t + (1 − αf)Δt against the
-                        // acceleration (1 − αm)a₁ + αm a₀; unfolding the αf-average gives
-                        // the acceleration that balances them at t + Δt (the integrator's
-                        // a₁ itself lags by (αf − αm)Δt: a whole step for ρ∞ = 0).
-                        let balanced = (1.0 - c.alpha_m) * a_new + c.alpha_m * b.accel[k];
-                        b.response_accel[k] =
-                            (balanced - c.alpha_f * b.response_accel[k]) / (1.0 - c.alpha_f);
-                        b.accel[k] = a_new;
-                    }
-                }
+        for (b, d) in self.blocks.iter_mut().zip(increments) {
+            if b.role == BlockRole::PrescribedGround {
+                b.velocity = [0.0; 6];
+                b.accel = [0.0; 6];
+                b.response_accel = [0.0; 6];
+                continue;
+            }
+            for k in 0..6 {
+                let (v0, a0) = (b.velocity[k], b.accel[k]);
+                let a_new = c.end_accel(d[k], v0, a0, dt);
+                b.velocity[k] = c.end_velocity(v0, a0, a_new, dt);
+                b.response_accel[k] = c.balanced_accel(a0, a_new, b.response_accel[k]);
+                b.accel[k] = a_new;
             }
         }
         // The integrator's own dissipation, from its states alone: the work of the average
@@ -2313,13 +2292,6 @@ impl Dda {
     }
 }
 
-/// Estimates where in a step a contact left its start state (0 = at the start, 1 = at the
-/// end), from the trial solution that showed the change:
-///
-/// - locked → sliding: where the shear force, linear over the step, reaches ρN;
-/// - sliding → locked: where the slip velocity, linear over the step (from its start value
-///   and the slip increment), passes through zero;
-/// - open → closed: where the gap, linear over the step, closes.
 /// What a trial solution says about a contact, for locating its event in the step.
 struct Transition {
     gap_end: f64,
@@ -2332,6 +2304,13 @@ struct Transition {
     normal_end: f64,
 }
 
+/// Estimates where in a step a contact left its start state (0 = at the start, 1 = at the
+/// end), from the trial solution that showed the change:
+///
+/// - locked → sliding: where the shear force, linear over the step, reaches ρN;
+/// - sliding → locked: where the slip velocity, linear over the step (from its start value
+///   and the slip increment), passes through zero;
+/// - open → closed: where the gap, linear over the step, closes.
 fn transition_fraction(c: &Contact, new_state: ContactState, t: Transition, dt: f64) -> f64 {
     let Transition {
         gap_end,

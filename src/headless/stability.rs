@@ -356,43 +356,53 @@ fn friction_ten(case: &str) -> StabilityRow {
     }
 }
 
-/// Five steps per excitation period (10 Hz at Δt = 0.02 s): the joint's fast slips are
-/// not resolved and the integrator damps them (the generalised-α scheme by design), so the
-/// slip cannot be accurate; the run must stay bounded, and the 1 Hz structure, resolved
-/// with 50 steps per period, must still be right.
+/// Five steps per excitation period (10 Hz at Δt = 0.02 s): the run must stay bounded,
+/// and at 20 steps per period the drift must be right.
+///
+/// Why not accurate at 5: the solver's frame moves with the ground, so the ground's
+/// acceleration is a body force that the integrator samples 5 times per period. The 1 Hz
+/// structure is resolved (50 steps per period), but the slow free vibration it starts with
+/// is set by the start transient of the fast forced response, whose velocity the scheme
+/// gets wrong by its amplitude error at ΩΔt = 1.26 (the trapezoidal rule's
+/// (ΩΔt/2)/tan(ΩΔt/2) = 0.865). Measured (default settings, 100 s): drift error 4.9 % at
+/// 5 steps per period; the set-up warns below 10.
 fn coarse_step(case: &str) -> StabilityRow {
-    let check = "finishes (5 steps per excitation period) with |energy residual| < 0.5; the \
-                 resolved structure's drift within 2 % of the exact model, the unresolved slip \
-                 within a factor 2";
-    let req = RunSpec {
-        excitation: ExcitationSpec::ratio(10.0),
-        dt: Some(0.02),
-        ..base_req()
+    let check = "at 5 steps per excitation period: finishes with |energy residual| < 0.5 and \
+                 the drift and the unresolved slip within a factor 2 of the exact model's; \
+                 at 20 steps per period: the drift within 2 %";
+    let run_at = |dt: f64| {
+        let req = RunSpec {
+            excitation: ExcitationSpec::ratio(10.0),
+            dt: Some(dt),
+            ..base_req()
+        };
+        let reference = exact(&req, None)?;
+        let (run, _) = two_block_run(&req, SolverParams::default(), |_| {})?;
+        Ok::<_, crate::error::Error>((run, reference))
     };
-    let reference = match exact(&req, None) {
-        Ok(r) => r,
-        Err(e) => return stopped(case, check, &e, false),
+    let (coarse, fine) = match (run_at(0.02), run_at(0.005)) {
+        (Ok(c), Ok(f)) => (c, f),
+        (Err(e), _) | (_, Err(e)) => return stopped(case, check, &e, false),
     };
-    match two_block_run(&req, SolverParams::default(), |_| {}) {
-        Ok((run, _)) => {
-            let drift_error = rel(run.peaks.drift_m, reference.peaks.drift_m);
-            let slip_ratio = run.peaks.slip_m / reference.peaks.slip_m;
-            from_run(
-                case,
-                &run,
-                check,
-                run.energy_residual_rel.abs() < 0.5
-                    && drift_error < 0.02
-                    && (0.5..2.0).contains(&slip_ratio),
-                format!(
-                    "drift error {drift_error:.1e}; slip {:.2e} m vs exact {:.2e} m \
-                     (ratio {slip_ratio:.2})",
-                    run.peaks.slip_m, reference.peaks.slip_m
-                ),
-            )
-        }
-        Err(e) => stopped(case, check, &e, false),
-    }
+    let (run, reference) = &coarse;
+    let within_2x = |a: f64, b: f64| (0.5..2.0).contains(&(a / b));
+    let coarse_drift = run.peaks.drift_m / reference.peaks.drift_m;
+    let slip_ratio = run.peaks.slip_m / reference.peaks.slip_m;
+    let fine_error = rel(fine.0.peaks.drift_m, fine.1.peaks.drift_m);
+    from_run(
+        case,
+        run,
+        check,
+        run.energy_residual_rel.abs() < 0.5
+            && within_2x(run.peaks.drift_m, reference.peaks.drift_m)
+            && within_2x(run.peaks.slip_m, reference.peaks.slip_m)
+            && fine_error < 0.02,
+        format!(
+            "5 steps/period: drift ratio {coarse_drift:.3}, slip {:.2e} m vs exact {:.2e} m \
+             (ratio {slip_ratio:.2}); 20 steps/period: drift error {fine_error:.1e}",
+            run.peaks.slip_m, reference.peaks.slip_m
+        ),
+    )
 }
 
 /// 0.001 g against a friction limit of 0.1 g: the joint never slides; the only motion
