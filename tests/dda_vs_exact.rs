@@ -6,7 +6,7 @@
 
 use slidebase::dda::{ContactEnforcement, Integrator, SolverParams};
 use slidebase::headless::run::run;
-use slidebase::headless::simulate::{ModelRun, run_dda, run_exact};
+use slidebase::headless::simulate::{ModelRun, run_dda, run_exact_two_block};
 use slidebase::headless::sweep::{SweepRequest, parse_ratios, run_sweep};
 use slidebase::post::sweep::error_table;
 use slidebase::setup::{ExcitationSpec, ModelKind, RunSpec};
@@ -163,17 +163,7 @@ fn dda_and_exact(
 ) -> (ModelRun, ModelRun) {
     let setup = spec.prepare().unwrap();
     let run = run_dda(&setup, &setup.scene, adjust(setup.solver_params())).unwrap();
-    let (roles, alpha, _) = setup.two_block().unwrap();
-    let exact = run_exact(
-        alpha,
-        roles.structure_frequency_hz,
-        roles.total_mass,
-        setup.friction,
-        &setup.motion,
-        setup.duration,
-        0.0,
-    )
-    .unwrap();
+    let exact = run_exact_two_block(&setup, 0.0).unwrap();
     (run, exact)
 }
 
