@@ -1868,17 +1868,6 @@ impl Dda {
                 // (In a restart step, an impact at its very start is part of this step.)
                 if !at_start && theta < 0.999 {
                     dt_override = Some(theta * dt);
-                    if std::env::var("DBG").is_ok() {
-                        for c in &self.contacts {
-                            eprintln!(
-                                "land theta {theta} {:?}->{:?} ef {} {}",
-                                c.start_state,
-                                c.state,
-                                c.event_fraction_in_step(),
-                                c.event_fraction
-                            );
-                        }
-                    }
                     // The states the contacts take at the event: given to them when the
                     // shortened step ends there (and resolved at the next step's start).
                     self.pending_events = self
