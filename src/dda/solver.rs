@@ -454,11 +454,11 @@ impl Dda {
     /// With the augmented Lagrangian the penalties only set how fast the multipliers
     /// converge: each iteration shrinks the constraint violation by about k/(k + p), k
     /// the stiffness the contact sees (inertia M/(βΔt²) or block elasticity). They are
-    /// raised to a hundred times that, so that a few iterations reach round-off, yet
-    /// not so far that the factorisation loses the soft directions (1e-16 · p/k).
+    /// raised to 1e4 times that, so that a few iterations reach round-off, yet not so
+    /// far that the factorisation loses the soft directions (1e-16 · p/k).
     fn scale_constraint_penalties(&mut self) {
         const FACTOR: f64 = 1e4;
-        let mass_factor = 1.0 / (self.coeffs.beta * self.params.dt * self.params.dt);
+        let mass_factor = self.inertia_stiffness_factor();
         let stiffness = |b: &Block| {
             if b.role == BlockRole::PrescribedGround {
                 0.0
@@ -472,6 +472,12 @@ impl Dda {
             c.props.normal_penalty = c.props.normal_penalty.max(FACTOR * k);
             c.props.shear_penalty = c.props.normal_penalty;
         }
+    }
+
+    /// The stiffness a unit mass shows over a full step, 1/(βΔt²): what the constraint
+    /// penalties are measured against.
+    fn inertia_stiffness_factor(&self) -> f64 {
+        1.0 / (self.coeffs.beta * self.params.dt * self.params.dt)
     }
 
     /// Starts the friction of each closed contact from its normal force extrapolated over
@@ -703,12 +709,10 @@ impl Dda {
         self.blocks.iter().map(|b| b.moments.centroid).collect()
     }
 
-    /// Known increments of prescribed blocks for a step from t to t + dt.
-    fn known_increments(&self, mode: Mode) -> PerBlock<Vec6> {
-        // The model moves with the ground (see `frame_offset`): a prescribed ground
-        // stands still in it, and the ground's acceleration acts on every block as a body
-        // force instead.
-        let _ = mode;
+    /// Known increments of the blocks without unknowns: none move, since the model moves
+    /// with the ground (see [`Dda::frame_displacement`]): a prescribed ground stands still
+    /// in it, and the ground's acceleration acts on every block as a body force instead.
+    fn known_increments(&self) -> PerBlock<Vec6> {
         PerBlock::from_elem([0.0; 6], self.blocks.len())
     }
 
@@ -1179,13 +1183,7 @@ impl Dda {
                 changes[1].0 = ds;
             }
             for (amount, grad_i, grad_j) in changes {
-                for (b, grad) in [(i, grad_i), (j, grad_j)] {
-                    if let Some(s) = self.dofs.slot[b] {
-                        for k in 0..6 {
-                            change[s + k] += amount * grad[k];
-                        }
-                    }
-                }
+                spread_force(&self.dofs, change, amount, [(i, grad_i), (j, grad_j)]);
             }
         }
         worst <= self.params.constraint_tolerance * scale
@@ -1554,16 +1552,15 @@ impl Dda {
             for (c, &old) in self.contacts.iter().zip(&forces_before) {
                 if let ContactState::Sliding { direction } = c.start_state {
                     let change = -direction * c.props.friction.min(1e30) * c.start_normal - old;
-                    for (blk, grad) in [
-                        (c.key.vertex_block, &c.slip_i),
-                        (c.key.edge_block, &c.slip_j),
-                    ] {
-                        if let Some(s) = self.dofs.slot[blk] {
-                            for k in 0..6 {
-                                friction_change[s + k] += change * grad[k];
-                            }
-                        }
-                    }
+                    spread_force(
+                        &self.dofs,
+                        &mut friction_change,
+                        change,
+                        [
+                            (c.key.vertex_block, &c.slip_i),
+                            (c.key.edge_block, &c.slip_j),
+                        ],
+                    );
                 }
             }
             if self.initial_accel_pending {
@@ -1634,7 +1631,7 @@ impl Dda {
     /// equilibrium.
     fn out_of_balance_forces(&self) -> Vec<f64> {
         let mode = Mode::Static { friction: None };
-        let known = self.known_increments(mode);
+        let known = self.known_increments();
         let sys = self.assemble_base(mode, &known, &self.element_terms());
         let mut forces: Vec<f64> = sys.r.iter().copied().collect();
         for (bi, b) in self.blocks.iter().enumerate() {
@@ -1660,7 +1657,7 @@ impl Dda {
         if extra.is_none() && !self.contacts.iter().any(|c| c.start_state.is_closed()) {
             return Ok(multipliers);
         }
-        let mass_factor = 1.0 / (self.coeffs.beta * self.params.dt * self.params.dt);
+        let mass_factor = self.inertia_stiffness_factor();
         let still = vec![[0.0; 6]; self.blocks.len()];
         let mut base = System::zeros(Arc::clone(&self.pattern), 1.0);
         for (bi, b) in self.blocks.iter().enumerate() {
@@ -1821,7 +1818,7 @@ impl Dda {
         loop {
             let dt = dt_override.unwrap_or(self.dt_current).min(max_dt);
             let mode = Mode::Dynamic { dt };
-            let known = self.known_increments(mode);
+            let known = self.known_increments();
             self.detect_contacts();
             self.predict_friction_normals(dt);
             let outcome = self.iterate(mode, &known)?;
@@ -2278,6 +2275,18 @@ impl Dda {
             observe(self, &report);
         }
         Ok(())
+    }
+}
+
+/// Adds a scalar contact force `amount`, acting along a contact's gradients on its two
+/// blocks, to the generalised forces `rhs` (blocks without unknowns take none).
+fn spread_force(dofs: &DofMap, rhs: &mut [f64], amount: f64, sides: [(usize, &Vec6); 2]) {
+    for (block, grad) in sides {
+        if let Some(s) = dofs.slot[block] {
+            for k in 0..6 {
+                rhs[s + k] += amount * grad[k];
+            }
+        }
     }
 }
 

@@ -389,13 +389,10 @@ impl Extractor {
             energy: dda.energy(),
             ..self.probes(dda, motion)
         };
-        let ground_now = probes.ground_disp as f32;
+        // Where the base would be had it not slipped: its start carried with the ground.
         let base_start = self.reference_vertices[self.base]
             .iter()
-            .map(|&v| {
-                let p = self.local(v, 0.0);
-                [p[0] + ground_now, p[1]]
-            })
+            .map(|&v| self.local(v, shift))
             .collect();
         ModelFrame {
             time: t,
