@@ -1863,8 +1863,7 @@ impl Dda {
                     return Ok(None);
                 }
                 // (In a restart step, an impact at its very start is part of this step.)
-                if !at_start && theta < 0.999 {
-                    dt_override = Some(theta * dt);
+                if !at_start && theta < 1.0 {
                     // The states the contacts take at the event: given to them when the
                     // shortened step ends there (and resolved at the next step's start).
                     self.pending_events = self
@@ -1888,11 +1887,13 @@ impl Dda {
                             (c.key, state)
                         })
                         .collect();
-                    self.last_landing = self.time + theta * dt;
-                    continue;
-                }
-                if !at_start && theta < 1.0 {
-                    // The event is at this step's end: the next step restarts.
+                    if theta < 0.999 {
+                        dt_override = Some(theta * dt);
+                        self.last_landing = self.time + theta * dt;
+                        continue;
+                    }
+                    // The event is at this step's end: the step is landed on it as it is,
+                    // and the next step restarts from the event's states.
                     dt_override = Some(dt);
                 }
             }
