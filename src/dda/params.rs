@@ -159,24 +159,22 @@ impl Integrator {
 
 /// How closed contacts carry their forces.
 ///
-/// The default is still the penalty method: the augmented Lagrangian removes the stuck
-/// joint's ringing (a_base/a_g +31 % at Δt = 1e-4 with the trapezoidal rule becomes
-/// exact; test `augmented_lagrangian_contacts_do_not_ring_at_fine_steps`), but two
-/// stability cases do not pass with it yet: a 100 Hz structure at Δt = 0.01 slips 10 %
-/// too far with the generalised-α scheme (event landing with an unresolved mode), the
-/// toppling block's energy residual is −4e-2 (limit 1e-2), and it takes more
-/// factorisations (see NOTES-issue-13.md).
+/// The default is the augmented Lagrangian: a stuck joint is exactly stuck, so the
+/// re-stick of the raft does not ring (with penalty springs a_base/a_g is +31 % at
+/// Δt = 1e-4 with the trapezoidal rule; test
+/// `augmented_lagrangian_contacts_do_not_ring_at_fine_steps`). The penalty method is kept
+/// for comparison with Shi's DDA and with codes that use it (OpenSees' flat slider).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum ContactEnforcement {
     /// Shi's penalty springs: a closed contact is a stiff spring, so a stuck joint is an
     /// oscillator (kHz) whose ringing at every re-stick equals the jump of the acceleration.
-    #[default]
     Penalty,
     /// Augmented Lagrangian: the penalty springs only regularise the solve; multipliers
     /// carry the contact forces, iterated until the constraint (no penetration, no slip
     /// while stuck) holds to [`SolverParams::constraint_tolerance`]. A stuck joint is then
     /// exactly stuck.
+    #[default]
     AugmentedLagrangian,
 }
 
