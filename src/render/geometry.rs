@@ -357,6 +357,17 @@ fn equivalent_strain(e: &[f32; 3]) -> f32 {
     (e[0] * e[0] + e[1] * e[1] + 0.5 * e[2] * e[2]).sqrt()
 }
 
+/// The smallest top of the colour scale: a microstrain, or a kilopascal. Below it
+/// nothing has deformed visibly, and a scale stretched over round-off (a rigid raft's
+/// 1e-38) would paint noise.
+pub fn color_scale_floor(color_by: ColorBy) -> f32 {
+    match color_by {
+        ColorBy::Material => f32::MIN_POSITIVE,
+        ColorBy::Stress => 1e3,
+        ColorBy::Strain => 1e-6,
+    }
+}
+
 /// The colour measure of a block for the colour scale.
 pub fn color_measure(color_by: ColorBy, stress: &[f32; 3], strain: &[f32; 3]) -> f32 {
     match color_by {

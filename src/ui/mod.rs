@@ -541,7 +541,7 @@ impl AppState {
 
     /// Largest colour measure over all frames so far (a stable colour scale).
     pub fn color_max(&self) -> f32 {
-        let mut m = f32::MIN_POSITIVE;
+        let mut m = crate::render::geometry::color_scale_floor(self.view.color_by);
         for f in &self.timeline.frames {
             for model in &f.models {
                 for b in model.blocks.iter().filter(|b| !b.is_ground) {
