@@ -267,8 +267,10 @@ struct SweepArgs {
     /// Friction coefficients ρ, comma-separated.
     #[arg(long, default_value = "0.01,0.05,0.1,0.25", allow_hyphen_values = true)]
     friction: String,
-    /// Frequency ratios: `lo:hi:n` (log-spaced) or a comma-separated list.
-    #[arg(long = "freq-ratios", default_value = "0.1:10:25")]
+    /// Frequency ratios: `paper` (the paper's 25 log-spaced ratios from 0.1 to 10, with the
+    /// three nearest to 0.5, 2 and 5 moved onto them), `lo:hi:n` (log-spaced) or a
+    /// comma-separated list.
+    #[arg(long = "freq-ratios", default_value = "paper")]
     freq_ratios: String,
     /// Amplitude of the harmonic ground acceleration, g.
     #[arg(

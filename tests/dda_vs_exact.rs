@@ -7,7 +7,7 @@
 use slidebase::dda::{ContactEnforcement, Integrator, SolverParams};
 use slidebase::headless::run::run;
 use slidebase::headless::simulate::{ModelRun, run_dda, run_exact_two_block};
-use slidebase::headless::sweep::{SweepRequest, parse_ratios, run_sweep};
+use slidebase::headless::sweep::{SweepRequest, paper_ratios, run_sweep};
 use slidebase::post::sweep::error_table;
 use slidebase::setup::{ExcitationSpec, ModelKind, RunSpec};
 
@@ -17,6 +17,17 @@ fn sweep(
     ratios: Vec<f64>,
     duration: f64,
 ) -> slidebase::post::sweep::ErrorTable {
+    sweep_with(alphas, frictions, ratios, duration, Integrator::default()).0
+}
+
+/// The sweep's error table and the DDA rows' energy residuals.
+fn sweep_with(
+    alphas: Vec<f64>,
+    frictions: Vec<f64>,
+    ratios: Vec<f64>,
+    duration: f64,
+    integrator: Integrator,
+) -> (slidebase::post::sweep::ErrorTable, Vec<f64>) {
     let req = SweepRequest {
         alphas,
         frictions,
@@ -24,14 +35,19 @@ fn sweep(
         amplitude_g: 0.3,
         duration: Some(duration),
         dt: Some(1e-3),
-        integrator: Some(Integrator::default()),
+        integrator: Some(integrator),
         confirm_large: false,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: None,
     };
     let (rows, failures) = run_sweep(&req, &|| {});
     assert!(failures.is_empty(), "failed runs: {failures:?}");
-    error_table(&rows, 0.01)
+    let residuals = rows
+        .iter()
+        .filter(|r| r.model == "dda")
+        .map(|r| r.energy_residual_rel.abs())
+        .collect();
+    (error_table(&rows, 0.01), residuals)
 }
 
 /// A dozen representative points (light and heavy raft, low and high friction, below, at
@@ -72,29 +88,53 @@ fn dda_matches_the_exact_model_on_representative_points() {
     }
 }
 
-/// The full Figs 4–9 grid (3 α × 4 ρ × 25 ratios, 100 s, 0.3 g, Δt = 1 ms): medians ≤ 1 %
-/// and 90th percentiles ≤ 3 % for |u_s|/D, |u_r|/D and |a_roof|/a_g; ≤ 3 % and ≤ 10 % for
-/// |a_base|/a_g. Slow (≈ 1 min in release): run with `cargo test --release -- --ignored`.
+/// The full Figs 4–9 grid (3 α × 4 ρ × the paper's 25 ratios, which include 0.5, 2 and 5;
+/// 100 s, 0.3 g, Δt = 1 ms) against issue 13's targets for every metric: median ≤ 0.1 %,
+/// 90th percentile ≤ 0.5 %, largest ≤ 2 %.
+///
+/// - The trapezoidal rule (non-dissipative) meets all of them, and its energy balance
+///   closes: residual median ≤ 1e-8, largest ≤ 1e-6 of the energy that passed through.
+/// - The default generalised-α (ρ∞ = 0) meets the medians and percentiles, and the largest
+///   error for u_r, a_base and a_roof. Its largest u_s error (6.2 % at (0.9, 0.05, 10),
+///   100 steps per period of the input, where the trapezoidal rule errs by 0.7 %) is not
+///   asserted: docs/validation.md reports it as a missed target.
+///
+/// Slow (≈ 4 min in release): run with `cargo test --release -- --ignored`.
 #[test]
 #[ignore]
-fn full_paper_grid_meets_the_acceptance_bounds() {
-    let t = sweep(
-        vec![0.1, 0.5, 0.9],
-        vec![0.01, 0.05, 0.1, 0.25],
-        parse_ratios("r", "0.1:10:25").unwrap(),
-        100.0,
-    );
-    println!("{t}");
-    for (k, m) in t.metrics.iter().enumerate() {
-        assert_eq!(m.count, 300);
-        let (med, p90) = if k == 2 { (0.03, 0.10) } else { (0.01, 0.03) };
-        assert!(
-            m.median <= med && m.p90 <= p90,
-            "{}: median {:.3} %, 90th {:.3} %",
-            m.name,
-            100.0 * m.median,
-            100.0 * m.p90
+fn full_paper_grid_meets_the_targets() {
+    for integrator in ["trapezoidal", "generalized-alpha:0"] {
+        let (t, residuals) = sweep_with(
+            vec![0.1, 0.5, 0.9],
+            vec![0.01, 0.05, 0.1, 0.25],
+            paper_ratios(),
+            100.0,
+            Integrator::parse(integrator).unwrap(),
         );
+        println!("{integrator}:\n{t}");
+        let dissipative = integrator != "trapezoidal";
+        for (k, m) in t.metrics.iter().enumerate() {
+            assert_eq!(m.count, 300);
+            let max_checked = !(dissipative && k == 0);
+            assert!(
+                m.median <= 1e-3 && m.p90 <= 5e-3 && (!max_checked || m.max <= 0.02),
+                "{integrator}, {}: median {:.3} %, 90th {:.3} %, max {:.3} % at {:?}",
+                m.name,
+                100.0 * m.median,
+                100.0 * m.p90,
+                100.0 * m.max,
+                m.worst
+            );
+        }
+        if !dissipative {
+            let mut r = residuals.clone();
+            r.sort_by(f64::total_cmp);
+            let (median, max) = (r[r.len() / 2], r[r.len() - 1]);
+            assert!(
+                median <= 1e-8 && max <= 1e-6,
+                "energy residual median {median:.1e}, max {max:.1e}"
+            );
+        }
     }
 }
 

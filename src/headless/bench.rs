@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use super::frame::run_frame;
 use super::run::run;
-use super::sweep::{SweepRequest, parse_ratios, run_sweep};
+use super::sweep::{SweepRequest, paper_ratios, parse_ratios, run_sweep};
 use crate::dda::{Dda, SolverParams};
 use crate::ground_motion::{GroundMotion, resolve_record};
 use crate::model::presets::resolve_scene;
@@ -356,7 +356,7 @@ fn time_sweep(options: &BenchOptions) -> Result<SweepTiming> {
         (
             vec![0.1, 0.5, 0.9],
             vec![0.01, 0.05, 0.1, 0.25],
-            parse_ratios("", "0.1:10:25")?,
+            paper_ratios(),
         )
     };
     let req = SweepRequest {

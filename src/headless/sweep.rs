@@ -75,9 +75,38 @@ pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>> {
     Ok(values)
 }
 
-/// Parses frequency ratios: `lo:hi:n` gives n log-spaced values from lo to hi inclusive
-/// (the paper's 0.1 to 10); anything else is a comma-separated list.
+/// The frequency ratios at which a log-spaced grid is most often read and where the
+/// errors are largest (the transitions between the regimes of Figs 4–9): the grid must
+/// contain them, not step over them.
+pub const KEY_RATIOS: [f64; 3] = [0.5, 2.0, 5.0];
+
+/// The validation grid of Ω/ω: the paper's 25 log-spaced ratios from 0.1 to 10 (with 1,
+/// resonance, in the middle), the point nearest to each of [`KEY_RATIOS`] moved onto it.
+pub fn paper_ratios() -> Vec<f64> {
+    let mut r = log_spaced(0.1, 10.0, 25);
+    for key in KEY_RATIOS {
+        let nearest = (0..r.len())
+            .min_by(|&i, &j| (r[i] / key).ln().abs().total_cmp(&(r[j] / key).ln().abs()))
+            .unwrap_or(0);
+        r[nearest] = key;
+    }
+    r
+}
+
+/// `n` (≥ 2) log-spaced values from `lo` to `hi` inclusive.
+fn log_spaced(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    let (a, b) = (lo.log10(), hi.log10());
+    (0..n)
+        .map(|k| 10f64.powf(a + (b - a) * k as f64 / (n - 1) as f64))
+        .collect()
+}
+
+/// Parses frequency ratios: `paper` is [`paper_ratios`]; `lo:hi:n` gives n log-spaced
+/// values from lo to hi inclusive; anything else is a comma-separated list.
 pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
+    if text.trim() == "paper" {
+        return Ok(paper_ratios());
+    }
     let parts: Vec<&str> = text.split(':').collect();
     if parts.len() != 3 {
         return parse_list(flag, text);
@@ -109,10 +138,7 @@ pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
     if n == 1 {
         return Ok(vec![lo]);
     }
-    let (a, b) = (lo.log10(), hi.log10());
-    Ok((0..n)
-        .map(|k| 10f64.powf(a + (b - a) * k as f64 / (n - 1) as f64))
-        .collect())
+    Ok(log_spaced(lo, hi, n))
 }
 
 /// Parses `I/N` (1 ≤ I ≤ N) for `--shard`.
@@ -296,6 +322,21 @@ mod tests {
             vec![0.5, 2.0]
         );
         assert!(parse_list("--alpha", "0.1,x").is_err());
+    }
+
+    #[test]
+    fn the_paper_grid_contains_the_key_ratios() {
+        let r = parse_ratios("--freq-ratios", "paper").unwrap();
+        let log = parse_ratios("--freq-ratios", "0.1:10:25").unwrap();
+        assert_eq!(r.len(), 25);
+        for key in KEY_RATIOS.iter().chain(&[0.1, 1.0, 10.0]) {
+            assert!(r.iter().any(|x| (x - key).abs() < 1e-12), "{key} missing");
+        }
+        // Only three points moved, each by less than half a grid interval (×10^(1/24)).
+        let moved: Vec<f64> = r.iter().zip(&log).filter(|(a, b)| a != b).map(|(a, b)| a / b).collect();
+        assert_eq!(moved.len(), 3);
+        assert!(moved.iter().all(|m| m.log10().abs() < 1.0 / 24.0));
+        assert!(r.windows(2).all(|w| w[0] < w[1]), "still increasing");
     }
 
     /// The shards of a grid are disjoint and together are the whole grid.
