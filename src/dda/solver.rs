@@ -126,6 +126,10 @@ impl NodeMotion for StepMotion<'_> {
     fn node_displacement(&self, b: usize, x: Point) -> Point {
         displacement_with_rotation(self.centroids[b], x, &self.increments[b], self.rotations[b])
     }
+
+    fn linear_node_displacement(&self, b: usize, x: Point) -> Point {
+        super::block::point_displacement(self.centroids[b], x, &self.increments[b])
+    }
 }
 
 /// The DDA model of a scene, advancing in time.
