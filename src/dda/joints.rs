@@ -326,9 +326,8 @@ impl Connection {
         // would strain a rigidly turning element by cos θ − 1, and a column connection
         // carrying a floor's weight would then take energy from gravity at every step
         // (the three-storey frame's fixed-base energy residual was 6e-2, O(Δt)).
-        let lin: [Point; 3] = std::array::from_fn(|k| {
-            motion.linear_node_displacement(self.blocks[k], self.nodes[k])
-        });
+        let lin: [Point; 3] =
+            std::array::from_fn(|k| motion.linear_node_displacement(self.blocks[k], self.nodes[k]));
         let flat: Vec6 = [
             lin[0][0], lin[0][1], lin[1][0], lin[1][1], lin[2][0], lin[2][1],
         ];

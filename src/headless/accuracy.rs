@@ -1006,7 +1006,10 @@ mod tests {
             row("trapezoidal", 1e-3, 0.001),
             row("classic", 1e-2, 0.02),
         ];
-        assert_eq!(cheapest_one_percent(&rows, "trapezoidal").map(|r| r.0), Some(1e-3));
+        assert_eq!(
+            cheapest_one_percent(&rows, "trapezoidal").map(|r| r.0),
+            Some(1e-3)
+        );
         assert_eq!(cheapest_one_percent(&rows, "classic"), None);
         let text = findings(&rows, &["trapezoidal".into(), "classic".into()]).join("\n");
         assert!(text.contains("trapezoidal at Δt = 1e-3 s"), "{text}");

@@ -333,7 +333,12 @@ mod tests {
             assert!(r.iter().any(|x| (x - key).abs() < 1e-12), "{key} missing");
         }
         // Only three points moved, each by less than half a grid interval (×10^(1/24)).
-        let moved: Vec<f64> = r.iter().zip(&log).filter(|(a, b)| a != b).map(|(a, b)| a / b).collect();
+        let moved: Vec<f64> = r
+            .iter()
+            .zip(&log)
+            .filter(|(a, b)| a != b)
+            .map(|(a, b)| a / b)
+            .collect();
         assert_eq!(moved.len(), 3);
         assert!(moved.iter().all(|m| m.log10().abs() < 1.0 / 24.0));
         assert!(r.windows(2).all(|w| w[0] < w[1]), "still increasing");

@@ -1,0 +1,157 @@
+//! Analyses outside the time stepping: static equilibrium (settle), the tangent stiffness and the modes.
+
+use super::*;
+
+impl Dda {
+    /// Static equilibrium under gravity and loads (the ground does not move).
+    pub(super) fn settle(&mut self) -> Result<()> {
+        // The weight is first let down on joints free to slip: a base slab that spreads
+        // under its load (Poisson) then does not leave the joint's shear springs holding a
+        // self-equilibrated force (at the frame's preload, most of ρN, so that the first
+        // tremor of the ground would make its ends slip). The joints then start stuck with
+        // no shear. Where that has no equilibrium (a block on a slope), the settle is done
+        // with Coulomb's law, and where even that has none (a slope too steep to hold), with
+        // every joint held; the first dynamic step then decides whether they slide.
+        let saved_memory = self.memory.clone();
+        if self.settle_with(Some(0.0)).is_ok() {
+            for m in self.memory.values_mut() {
+                if m.state.is_closed() {
+                    m.state = ContactState::Locked;
+                    m.shear = 0.0;
+                }
+            }
+            return Ok(());
+        }
+        self.memory = saved_memory.clone();
+        if self.settle_with(None).is_ok() {
+            return Ok(());
+        }
+        self.memory = saved_memory;
+        self.settle_with(Some(f64::INFINITY))
+    }
+
+    pub(super) fn settle_with(&mut self, friction: Option<f64>) -> Result<()> {
+        let known = vec![[0.0; 6]; self.blocks.len()];
+        self.detect_contacts();
+        let Some((increments, _)) = self.iterate(Mode::Static { friction }, &known)? else {
+            return Err(Error::Solver {
+                time: 0.0,
+                reason:
+                    "the initial equilibrium under gravity did not settle (contact states keep \
+                         changing); check that blocks rest on each other, or set \
+                         solver.initial_equilibrium = false"
+                        .into(),
+            });
+        };
+        let (block, ratio) = self.most_displaced_block(&increments);
+        // Supported blocks settle by millimetres (a roof hung on a 1 Hz spring by 25 cm);
+        // an unsupported one falls by g/(2π·1 mHz)² ≈ 250 km on the regularising spring.
+        if ratio > 1.0 {
+            return Err(Error::Solver {
+                time: 0.0,
+                reason: format!(
+                    "block '{}' would move {ratio:.3e} structure sizes to reach equilibrium \
+                     under gravity: it is not supported (declare a contact with the block it \
+                     rests on, or a bolt or fixed point that holds it)",
+                    self.blocks[block].name
+                ),
+            });
+        }
+        self.commit_geometry(&increments)?;
+        Ok(())
+    }
+
+    /// Natural frequencies and mode shapes of the model about its current state, with every
+    /// touching contact stuck (a fixed base when the joint is closed): the generalised
+    /// eigenproblem K φ = ω² M φ of the tangent stiffness (see [`Dda::tangent_stiffness`])
+    /// and the block mass matrices.
+    pub fn modes(&self) -> Result<Modes> {
+        let model = self.clone();
+        let k = model.tangent_stiffness()?;
+        let mut mass = System::zeros(Arc::clone(&model.pattern), 1.0);
+        for (bi, b) in model.blocks.iter().enumerate() {
+            if let Some(s) = model.dofs.slot[bi] {
+                mass.add_diag_block(s, &b.mass, 1.0);
+            }
+        }
+        let modal = crate::linalg::modal(&mass.k.to_dense(), &k)?;
+        let mut frequencies_hz = Vec::new();
+        let mut shapes = Vec::new();
+        for (col, &w) in modal.omega.iter().enumerate() {
+            frequencies_hz.push(w / (2.0 * std::f64::consts::PI));
+            let shape: Vec<Vec6> = (0..model.blocks.len())
+                .map(|bi| match model.dofs.slot[bi] {
+                    Some(s) => {
+                        let mut d = [0.0; 6];
+                        for k in 0..6 {
+                            d[k] = modal.phi[(s + k, col)];
+                        }
+                        d
+                    }
+                    None => [0.0; 6],
+                })
+                .collect();
+            shapes.push(shape);
+        }
+        Ok(Modes {
+            frequencies_hz,
+            shapes,
+        })
+    }
+
+    /// Out-of-balance force f_ext − f_int at the current state with every touching contact
+    /// stuck: the right-hand side of a static step with zero increment.
+    pub(super) fn out_of_balance(&mut self) -> DVector<f64> {
+        self.detect_contacts();
+        for c in &mut self.contacts {
+            if c.gap0 <= 0.0 || c.state.is_closed() {
+                c.state = ContactState::Locked;
+            }
+        }
+        let known = vec![[0.0; 6]; self.blocks.len()];
+        let elements = self.element_terms();
+        let mut sys = self.assemble_base(Mode::Modal, &known, &elements);
+        self.add_contacts(&mut sys, &known, Mode::Modal);
+        sys.r
+    }
+
+    /// Tangent stiffness of the model about its current state: the derivative of the
+    /// internal forces with respect to the unknowns *through the solver's own update* (moved
+    /// vertices, accumulated stresses, re-detected contacts), by central differences.
+    /// Besides the elastic, joint and contact stiffness it contains the geometric stiffness
+    /// of the stresses the model carries — under a heavy gravity preload, the P-Δ softening
+    /// that the time stepping shows and a plain assembly of K would miss.
+    pub fn tangent_stiffness(&self) -> Result<nalgebra::DMatrix<f64>> {
+        let n = self.dofs.n;
+        let mut base = self.clone();
+        base.out_of_balance();
+        let mut k = nalgebra::DMatrix::zeros(n, n);
+        // Perturbations: small against the model (1e-7 of its size for translations, 1e-7
+        // rad, 1e-9 strain) yet far above rounding of the forces they produce.
+        let steps = [
+            1e-7 * self.structure_size,
+            1e-7 * self.structure_size,
+            1e-7,
+            1e-9,
+            1e-9,
+            1e-9,
+        ];
+        for (bi, slot) in self.dofs.slot.iter().enumerate() {
+            let Some(s) = *slot else { continue };
+            for dof in 0..6 {
+                let h = steps[dof];
+                let mut r = [DVector::zeros(0), DVector::zeros(0)];
+                for (side, sign) in [(0, 1.0), (1, -1.0)] {
+                    let mut m = base.clone();
+                    let mut inc = vec![[0.0; 6]; m.blocks.len()];
+                    inc[bi][dof] = sign * h;
+                    m.commit_geometry(&inc)?;
+                    r[side] = m.out_of_balance();
+                }
+                let col = (&r[0] - &r[1]) / (-2.0 * h);
+                k.set_column(s + dof, &col);
+            }
+        }
+        Ok((&k + k.transpose()) * 0.5)
+    }
+}

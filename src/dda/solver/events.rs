@@ -1,0 +1,260 @@
+//! Contact events: the resolution of velocities, accelerations and contact states at the start of the step after a landing (projection onto the constraints).
+
+use super::*;
+
+impl Dda {
+    /// Makes the contacts' trial states (found at the very start of a step) their start
+    /// states for the retry of the step.
+    pub(super) fn adopt_trial_states(&mut self) {
+        for c in &self.contacts {
+            if c.state == c.start_state {
+                continue;
+            }
+            let m = self.memory.entry(c.key).or_insert(ContactMemory {
+                state: c.start_state,
+                shear: 0.0,
+                normal_force: 0.0,
+                normal_change: 0.0,
+                shear_multiplier: 0.0,
+                shear_change: 0.0,
+            });
+            m.state = c.state;
+            m.shear = 0.0;
+            m.normal_change = 0.0;
+            m.shear_change = 0.0;
+            if !c.state.is_closed() {
+                m.normal_force = 0.0;
+                m.shear_multiplier = 0.0;
+            }
+        }
+    }
+
+    /// Resolves the contact states right after an event (the start of the step after a
+    /// landing), exactly as the event-driven rigid-body model does: the velocities and
+    /// accelerations are projected onto the constraints of the closed contacts (see
+    /// [`Dda::project`]), and the contact forces that this takes are judged — a contact
+    /// that would have to pull opens, one whose stick force exceeds ρN slides the way it
+    /// is pulled — until the states agree with their forces. Any integrator then carries
+    /// on from a consistent state instead of ringing on the acceleration before the event.
+    pub(super) fn resolve_event(&mut self) -> Result<()> {
+        self.detect_contacts();
+        let kinetic_before = self.kinetic_energy();
+        // Each round starts again from the motion before the event: a projection is not
+        // undone by projecting on fewer constraints.
+        let before: Vec<[Vec6; 3]> = self
+            .blocks
+            .iter()
+            .map(|b| [b.velocity, b.accel, b.response_accel])
+            .collect();
+        // The tangential force each contact carried before the event (on the vertex,
+        // along t̂): a sliding contact's friction, a stuck one's multiplier.
+        let forces_before: Vec<f64> = self
+            .contacts
+            .iter()
+            .map(|c| c.start_shear_multiplier)
+            .collect();
+        let initial_forces = if self.initial_accel_pending {
+            self.out_of_balance_forces()
+        } else {
+            Vec::new()
+        };
+        for _ in 0..=MAX_FLIPS_PER_STEP {
+            for (b, saved) in self.blocks.iter_mut().zip(&before) {
+                [b.velocity, b.accel, b.response_accel] = *saved;
+            }
+            // Friction that changes at the event (a slip that reverses, a stick that
+            // breaks at a force other than ρN) changes the accelerations as well.
+            let mut friction_change = vec![0.0; self.dofs.n];
+            for (c, &old) in self.contacts.iter().zip(&forces_before) {
+                if let ContactState::Sliding { direction } = c.start_state {
+                    let change = -direction * c.props.friction.min(1e30) * c.start_normal - old;
+                    spread_force(
+                        &self.dofs,
+                        &mut friction_change,
+                        change,
+                        [
+                            (c.key.vertex_block, &c.slip_i),
+                            (c.key.edge_block, &c.slip_j),
+                        ],
+                    );
+                }
+            }
+            if self.initial_accel_pending {
+                for (f, r) in friction_change.iter_mut().zip(&initial_forces) {
+                    *f += r;
+                }
+            }
+            self.hold_rigid_change(&mut friction_change);
+            self.project(Field::Velocity, None)?;
+            let changes = self.project(Field::Response, Some(&friction_change))?;
+            // The integrator restarts from the event as from an initial state: its
+            // acceleration variable is the acceleration that balances the forces (for the
+            // generalised-α family the variable otherwise lags the forces).
+            for b in &mut self.blocks {
+                b.accel = b.response_accel;
+            }
+            let mut changed = false;
+            for (c, [dn, ds]) in self.contacts.iter_mut().zip(changes) {
+                if !c.start_state.is_closed() || c.props.bonded {
+                    continue;
+                }
+                let normal = c.start_normal + dn;
+                let shear = c.start_shear_multiplier + ds;
+                let new_state = if normal < 0.0 {
+                    ContactState::Open
+                } else if c.start_state == ContactState::Locked
+                    && shear.abs() > c.props.friction * normal * (1.0 + 1e-9)
+                {
+                    // The stick force on the vertex is −(pull): it slides the way pulled.
+                    ContactState::Sliding {
+                        direction: if shear > 0.0 { -1.0 } else { 1.0 },
+                    }
+                } else {
+                    c.start_state
+                };
+                if new_state != c.start_state {
+                    c.start_state = new_state;
+                    c.state = new_state;
+                    changed = true;
+                }
+                let shear_force = match new_state {
+                    ContactState::Locked => shear,
+                    ContactState::Sliding { direction } => {
+                        -direction * c.props.friction.min(1e30) * normal
+                    }
+                    ContactState::Open => 0.0,
+                };
+                if let Some(m) = self.memory.get_mut(&c.key) {
+                    m.state = new_state;
+                    m.normal_force = if new_state.is_closed() { normal } else { 0.0 };
+                    m.shear_multiplier = shear_force;
+                    m.normal_change = 0.0;
+                    m.shear_change = 0.0;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        self.energy.impact_dissipated += kinetic_before - self.kinetic_energy();
+        self.initial_accel_pending = false;
+        Ok(())
+    }
+
+    /// The forces not in balance at the current state (loads, gravity, the ground's
+    /// body force, less the internal forces), per degree of freedom; with the stored
+    /// velocities they give the initial accelerations of a model released out of
+    /// equilibrium.
+    pub(super) fn out_of_balance_forces(&self) -> Vec<f64> {
+        let mode = Mode::Static { friction: None };
+        let known = self.known_increments();
+        let sys = self.assemble_base(mode, &known, &self.element_terms());
+        let mut forces: Vec<f64> = sys.r.iter().copied().collect();
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if let Some(s) = self.dofs.slot[bi]
+                && b.role != BlockRole::LargeMassGround
+            {
+                forces[s] -= b.total_mass() * self.ground_accel(self.time);
+            }
+        }
+        forces
+    }
+
+    /// Projects the velocities or accelerations of the free blocks onto the constraints
+    /// of the contacts' start states (closed: no approach; locked: no slip), in the metric
+    /// of the mass matrix: x⁺ = x − M⁻¹Gᵀ(GM⁻¹Gᵀ)⁻¹G x, solved by the augmented
+    /// Lagrangian (redundant constraints, as a flat face on two corners, are fine).
+    /// Returns, per contact, the change of its (normal, shear) force that the projection
+    /// of the accelerations takes (in N; for velocities, the impulse in N·s).
+    /// `extra`: generalised forces added to the field's momentum (M x + extra), for the
+    /// accelerations the force changes the event makes besides the constraints'.
+    pub(super) fn project(&mut self, field: Field, extra: Option<&[f64]>) -> Result<Vec<[f64; 2]>> {
+        let mut multipliers = vec![[0.0_f64; 2]; self.contacts.len()];
+        if extra.is_none() && !self.contacts.iter().any(|c| c.start_state.is_closed()) {
+            return Ok(multipliers);
+        }
+        let mass_factor = self.inertia_stiffness_factor();
+        let still = vec![[0.0; 6]; self.blocks.len()];
+        let mut base = System::zeros(Arc::clone(&self.pattern), 1.0);
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if let Some(s) = self.dofs.slot[bi] {
+                base.add_diag_block(s, &b.mass, 1.0);
+                let x = field.of(b);
+                let mut mx = [0.0; 6];
+                for i in 0..6 {
+                    mx[i] = (0..6).map(|j| b.mass[i][j] * x[j]).sum();
+                }
+                base.add_rhs(s, &mx, 1.0);
+            }
+        }
+        if let Some(extra) = extra {
+            for (r, e) in base.r.iter_mut().zip(extra) {
+                *r += e;
+            }
+        }
+        let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
+        let key = 0x5eed_0000_0000_0001 ^ mass_factor.to_bits();
+        for _ in 0..200 {
+            let mut sys = base.clone();
+            for (c, m) in self.contacts.iter().zip(&multipliers) {
+                let p = c.props.normal_penalty / mass_factor;
+                let (i, j) = (c.key.vertex_block, c.key.edge_block);
+                if c.start_state.is_closed() {
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        &still,
+                        p,
+                        -m[0],
+                        (i, &c.gap_i),
+                        Some((j, &c.gap_j)),
+                    );
+                }
+                if c.start_state == ContactState::Locked {
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        &still,
+                        p,
+                        -m[1],
+                        (i, &c.slip_i),
+                        Some((j, &c.slip_j)),
+                    );
+                }
+            }
+            self.hold_rigid_strains(&mut sys);
+            self.linear
+                .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
+                .map_err(|e| self.solve_error(e))?;
+            let x = self.increments(&solution, &still);
+            let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+            for (c, m) in self.contacts.iter().zip(multipliers.iter_mut()) {
+                let p = c.props.normal_penalty / mass_factor;
+                let rate = |a: &Vec6, b: &Vec6| {
+                    dot6(a, &x[c.key.vertex_block]) + dot6(b, &x[c.key.edge_block])
+                };
+                // Force (normal: pushing apart; shear: on the vertex along t̂) that the
+                // constraint takes: λ ← λ − p·g, as for the step's contacts.
+                if c.start_state.is_closed() {
+                    let d = -p * rate(&c.gap_i, &c.gap_j);
+                    m[0] += d;
+                    worst = worst.max(d.abs());
+                    scale = scale.max(m[0].abs());
+                }
+                if c.start_state == ContactState::Locked {
+                    let d = -p * rate(&c.slip_i, &c.slip_j);
+                    m[1] += d;
+                    worst = worst.max(d.abs());
+                    scale = scale.max(m[1].abs());
+                }
+            }
+            if worst <= self.params.constraint_tolerance * scale || scale == 0.0 {
+                for (bi, b) in self.blocks.iter_mut().enumerate() {
+                    if self.dofs.slot[bi].is_some() {
+                        *field.of_mut(b) = x[bi];
+                    }
+                }
+                break;
+            }
+        }
+        Ok(multipliers)
+    }
+}

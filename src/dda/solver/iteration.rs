@@ -1,0 +1,440 @@
+//! The open-close iteration of one step: solve, judge the contacts, update the multipliers, repeat until the states hold.
+
+use super::*;
+
+impl Dda {
+    /// Runs the open-close iteration. Returns the increments of all blocks and the number
+    /// of passes, or `None` if the states did not settle within the allowed passes.
+    pub(super) fn iterate(
+        &mut self,
+        mode: Mode,
+        known: &[Vec6],
+    ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
+        let mut elements = std::mem::take(&mut self.elements);
+        self.element_terms_into(&mut elements);
+        let mut base = self
+            .base_system
+            .take()
+            .unwrap_or_else(|| System::zeros(Arc::clone(&self.pattern), 1.0));
+        self.assemble_base_into(&mut base, mode, known, &elements);
+        self.elements = elements;
+        let result = self.open_close(mode, known, &base);
+        self.base_system = Some(base);
+        result
+    }
+
+    /// The open-close passes of one step on its base system.
+    pub(super) fn open_close(
+        &mut self,
+        mode: Mode,
+        known: &[Vec6],
+        base: &System,
+    ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
+        let alpha_f = match mode {
+            Mode::Dynamic { .. } => self.coeffs.alpha_f,
+            Mode::Static { .. } | Mode::Modal => 0.0,
+        };
+        // A closed contact whose gap opens by less than this stays closed (so that one
+        // resting at zero force does not flicker). Its spring then pulls, by at most
+        // p·tolerance: 1e-12 of the size keeps that tension far below any force of
+        // interest (0.3 mN per metre of size for p = 1e12 N/m; a tolerance of 1e-9 of
+        // the size let a 2 m block hang on 2 kN and held it down past its uplift
+        // threshold), yet well above the rounding of the gap (1e-16 of the size).
+        let open_tolerance = 1e-12 * self.structure_size;
+        let slip_tolerance = 1e-12 * self.structure_size;
+        let max_passes = self.params.max_open_close_passes;
+        // Inline for the systems the linear solver factorises on the stack.
+        let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
+        for pass in 1..=max_passes {
+            let increments = self.solve_pass(mode, known, base, &mut solution)?;
+            let velocities = match mode {
+                Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
+                Mode::Static { .. } | Mode::Modal => {
+                    PerBlock::from_elem([0.0; 6], self.blocks.len())
+                }
+            };
+            let augmented = self.augmented();
+            let mut changed = false;
+            let mut contradicted = false;
+            let mut max_normal = 0.0_f64;
+            for c in &self.contacts {
+                max_normal = max_normal.max(c.friction_normal);
+            }
+            for c in &mut self.contacts {
+                let di = &increments[c.key.vertex_block];
+                let dj = &increments[c.key.edge_block];
+                let gap = c.gap_end(di, dj);
+                let slip = c.slip_increment(di, dj);
+                let slip_velocity = dot6(&c.slip_i, &velocities[c.key.vertex_block])
+                    + dot6(&c.slip_j, &velocities[c.key.edge_block]);
+                // The forces the judge weighs: the springs' (penalty) or the multipliers'
+                // (augmented Lagrangian, where a closed contact's gap is held at zero and
+                // its force says whether it would rather open: the penalty-equivalent
+                // gap −λ/p).
+                let p = c.props.normal_penalty;
+                let ps = c.props.shear_penalty;
+                let (judged_gap, normal_force, shear_start, shear_force) =
+                    if augmented && c.state.is_closed() {
+                        (
+                            -c.normal_multiplier / p,
+                            c.normal_multiplier.max(0.0),
+                            -c.start_shear_multiplier,
+                            -c.shear_multiplier,
+                        )
+                    } else {
+                        (
+                            gap,
+                            p * (-gap).max(0.0),
+                            ps * c.shear0,
+                            ps * (c.shear0 + slip),
+                        )
+                    };
+                c.end_slip_velocity = slip_velocity;
+                let new_state = judge(&JudgeInput {
+                    state: c.state,
+                    gap: judged_gap,
+                    shear_force,
+                    normal_force,
+                    // The static settle holds every joint stuck: it finds the preload of
+                    // the normal springs; whether friction can hold the blocks is decided
+                    // by the first dynamic step (a block on a steep slope starts sliding).
+                    friction: match mode {
+                        Mode::Static { friction: Some(f) } => f,
+                        Mode::Modal => f64::INFINITY,
+                        _ => c.props.friction,
+                    },
+                    slip_increment: slip,
+                    slip_velocity,
+                    bonded: c.props.bonded,
+                    open_tolerance,
+                    slip_tolerance,
+                });
+                // Friction acts with the normal force at the generalised-α time point.
+                let n_alpha = if augmented && c.state.is_closed() {
+                    alpha_f * c.start_normal + (1.0 - alpha_f) * normal_force
+                } else {
+                    let gap_alpha = alpha_f * c.gap0 + (1.0 - alpha_f) * gap;
+                    p * (-gap_alpha).max(0.0)
+                };
+                // The friction force uses the normal force of the previous pass (keeping K
+                // symmetric); iterate until it moves by < 1e-4: the friction force is then
+                // within 1e-4·ρN of the implicit one, far below the accuracy targets, while a
+                // tighter bound only buys passes when the penalty springs ring.
+                if let ContactState::Sliding { .. } = new_state
+                    && (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha)
+                {
+                    changed = true;
+                }
+                c.friction_normal = n_alpha;
+                // A contact that keeps flipping within one step (stuck ↔ sliding with the
+                // penalty spring's unresolved dynamics on either side of the limit) keeps
+                // its latest state: the step is then decided, at a small cost in accuracy,
+                // instead of being cut down to nothing.
+                if new_state != c.state && c.flips >= MAX_FLIPS_PER_STEP {
+                    // ...but never open while penetrating, nor closed while apart: the
+                    // first lets the vertex pass into the other block unopposed (and the
+                    // spring throws it back out with energy it never had), the second
+                    // holds it with a spring in tension. The step is cut instead.
+                    contradicted |= match c.state {
+                        ContactState::Open => gap < 0.0,
+                        _ => judged_gap > open_tolerance,
+                    };
+                    continue;
+                }
+                if new_state != c.state {
+                    c.flips += 1;
+                    if c.state == c.start_state {
+                        c.event_fraction = match mode {
+                            Mode::Dynamic { dt } => transition_fraction(
+                                c,
+                                new_state,
+                                Transition {
+                                    gap_end: gap,
+                                    slip,
+                                    slip_velocity_end: slip_velocity,
+                                    shear_start,
+                                    shear_end: shear_force,
+                                    normal_end: normal_force,
+                                },
+                                dt,
+                            ),
+                            Mode::Static { .. } | Mode::Modal => 1.0,
+                        };
+                    }
+                    changed = true;
+                    // A contact that opens drops its multipliers; one that closes starts
+                    // from none; one that starts to slide keeps its normal force.
+                    if !new_state.is_closed() {
+                        c.normal_multiplier = 0.0;
+                        c.shear_multiplier = 0.0;
+                    }
+                    c.state = new_state;
+                }
+            }
+            if contradicted {
+                return Ok(None);
+            }
+            if !changed {
+                return Ok(Some((increments, pass)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Solves one open-close pass with the contacts' trial states: one linear solve with
+    /// penalty springs, or, with the augmented Lagrangian, solves with the same matrix
+    /// until every closed contact's constraint holds, updating the multipliers
+    /// (λ ← λ − p·g) after each. Returns the increments of all blocks.
+    pub(super) fn solve_pass(
+        &mut self,
+        mode: Mode,
+        known: &[Vec6],
+        base: &System,
+        solution: &mut SmallVec<[f64; TINY_LIMIT]>,
+    ) -> Result<PerBlock<Vec6>> {
+        const MAX_ITERATIONS: usize = 200;
+        let mut sys = match self.pass_system.take() {
+            Some(mut sys) => {
+                sys.copy_from(base);
+                sys
+            }
+            None => base.clone(),
+        };
+        self.add_contacts(&mut sys, known, mode);
+        self.hold_rigid_strains(&mut sys);
+        let structure = self.structure_key(mode);
+        let solved = self
+            .linear
+            .solve(&sys.k, sys.r.as_slice(), structure, solution);
+        let result = solved.map_err(|e| self.solve_error(e)).and_then(|()| {
+            let mut increments = self.increments(solution, known);
+            if !self.augmented() {
+                return Ok(increments);
+            }
+            // Augmented Lagrangian: the matrix stays, only the multipliers' part of the
+            // right-hand side changes (λ enters as −λ·∇g of the constraint energy).
+            let mut change = vec![0.0; self.dofs.n];
+            for _ in 0..MAX_ITERATIONS {
+                self.counters.constraint_iterations += 1;
+                change.fill(0.0);
+                if self.update_multipliers(&increments, &mut change) {
+                    break;
+                }
+                self.hold_rigid_change(&mut change);
+                self.linear
+                    .solve_change(&sys.k, &change, structure, solution)
+                    .map_err(|e| self.solve_error(e))?;
+                increments = self.increments(solution, known);
+            }
+            Ok(increments)
+        });
+        self.pass_system = Some(sys);
+        result
+    }
+
+    /// One augmented-Lagrangian update, λ ← λ − p·g, of every closed contact's
+    /// multipliers from the constraint violations g at `increments`; their change is
+    /// added to `change` (a change of the right-hand side). True when the violations were
+    /// already within the tolerance (the multipliers are then the forces of `increments`).
+    pub(super) fn update_multipliers(&mut self, increments: &[Vec6], change: &mut [f64]) -> bool {
+        let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+        for c in &mut self.contacts {
+            if !c.state.is_closed() {
+                continue;
+            }
+            let (i, j) = (c.key.vertex_block, c.key.edge_block);
+            let (di, dj) = (&increments[i], &increments[j]);
+            let dn = -c.props.normal_penalty * c.gap_end(di, dj);
+            c.normal_multiplier += dn;
+            worst = worst.max(dn.abs());
+            scale = scale.max(c.normal_multiplier.abs());
+            let mut changes = [(dn, &c.gap_i, &c.gap_j), (0.0, &c.slip_i, &c.slip_j)];
+            if c.state == ContactState::Locked {
+                let ds = -c.props.shear_penalty * (c.shear0 + c.slip_increment(di, dj));
+                c.shear_multiplier += ds;
+                worst = worst.max(ds.abs());
+                scale = scale.max(c.shear_multiplier.abs());
+                changes[1].0 = ds;
+            }
+            for (amount, grad_i, grad_j) in changes {
+                spread_force(&self.dofs, change, amount, [(i, grad_i), (j, grad_j)]);
+            }
+        }
+        worst <= self.params.constraint_tolerance * scale
+    }
+
+    /// Identifies what changes the whole system matrix (rather than its drift with the
+    /// geometry, or the low-rank change of contacts changing state): the problem solved,
+    /// the step size and the scheme. The linear solver tries its kept factor only while
+    /// this stays the same.
+    pub(super) fn structure_key(&self, mode: Mode) -> u64 {
+        const PRIME: u64 = 0x0000_0100_0000_01b3;
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut mix = |v: u64| h = (h ^ v).wrapping_mul(PRIME);
+        match mode {
+            Mode::Dynamic { dt } => {
+                mix(1);
+                mix(dt.to_bits());
+                mix(self.coeffs.beta.to_bits());
+                mix(self.coeffs.alpha_m.to_bits());
+                mix(self.coeffs.alpha_f.to_bits());
+                mix(self.params.contact_damping.to_bits());
+            }
+            Mode::Static { friction } => {
+                mix(2);
+                mix(friction.map_or(u64::MAX, f64::to_bits));
+            }
+            Mode::Modal => mix(3),
+        }
+        h
+    }
+
+    /// A linear-solve failure as a solver error saying what to check.
+    pub(super) fn solve_error(&self, e: SolveError) -> Error {
+        let reason = match e {
+            SolveError::NotPositiveDefinite => {
+                "the system matrix is not positive definite: a block is unsupported or a \
+                 penalty/material constant is negative or far too large"
+            }
+            SolveError::NonFinite => {
+                "the system contains a non-finite value (NaN/inf); check material constants, \
+                 penalties and the time step"
+            }
+            SolveError::OutsidePattern => {
+                "internal error: a joint or contact couples blocks the system pattern does \
+                 not hold"
+            }
+        };
+        Error::Solver {
+            time: self.time,
+            reason: reason.into(),
+        }
+    }
+
+    /// Velocities at the end of a trial step (Newmark update; the prescribed ground's
+    /// from the motion), used to judge slip reversals.
+    pub(super) fn end_velocities(&self, increments: &[Vec6], dt: f64) -> PerBlock<Vec6> {
+        let c = &self.coeffs;
+        self.blocks
+            .iter()
+            .zip(increments)
+            .map(|(b, d)| match b.role {
+                BlockRole::PrescribedGround => [0.0; 6],
+                _ => {
+                    let mut v = [0.0; 6];
+                    for k in 0..6 {
+                        let a_new = c.end_accel(d[k], b.velocity[k], b.accel[k], dt);
+                        v[k] = c.end_velocity(b.velocity[k], b.accel[k], a_new, dt);
+                    }
+                    v
+                }
+            })
+            .collect()
+    }
+
+    /// Increments of all blocks from the solution vector and the known ones.
+    pub(super) fn increments(&self, solution: &[f64], known: &[Vec6]) -> PerBlock<Vec6> {
+        (0..self.blocks.len())
+            .map(|b| match self.dofs.slot[b] {
+                Some(s) => {
+                    let mut d = [0.0; 6];
+                    d.copy_from_slice(&solution[s..s + 6]);
+                    d
+                }
+                None => known[b],
+            })
+            .collect()
+    }
+}
+
+/// What a trial solution says about a contact, for locating its event in the step.
+pub(super) struct Transition {
+    pub(super) gap_end: f64,
+    pub(super) slip: f64,
+    pub(super) slip_velocity_end: f64,
+    /// Shear force (the pull on the stick) at the step start and end, N.
+    pub(super) shear_start: f64,
+    pub(super) shear_end: f64,
+    /// Normal force at the step end, N.
+    pub(super) normal_end: f64,
+}
+
+/// Estimates where in a step a contact left its start state (0 = at the start, 1 = at the
+/// end), from the trial solution that showed the change:
+///
+/// - locked → sliding: where the shear force, linear over the step, reaches ρN;
+/// - sliding → locked: where the slip velocity, linear over the step (from its start value
+///   and the slip increment), passes through zero;
+/// - open → closed: where the gap, linear over the step, closes.
+pub(super) fn transition_fraction(
+    c: &Contact,
+    new_state: ContactState,
+    t: Transition,
+    dt: f64,
+) -> f64 {
+    let Transition {
+        gap_end,
+        slip,
+        slip_velocity_end,
+        shear_start,
+        shear_end,
+        normal_end,
+    } = t;
+    let theta = match (c.state, new_state) {
+        (ContactState::Locked, ContactState::Sliding { .. }) => {
+            let f0 = shear_start.abs();
+            let f1 = shear_end.abs();
+            let limit = c.props.friction * normal_end;
+            if f1 > f0 {
+                (limit - f0) / (f1 - f0)
+            } else {
+                1.0
+            }
+        }
+        (ContactState::Sliding { direction }, ContactState::Locked) => {
+            // The slip velocity, linear over the step, passes through zero.
+            let v0 = c.start_slip_velocity * direction;
+            let v1 = slip_velocity_end * direction;
+            if v0 <= 0.0 {
+                // Already reversing when the step began.
+                0.0
+            } else if v1 < v0 {
+                v0 / (v0 - v1)
+            } else {
+                // Only the displacement reversed: s(τ) = v0 τ + ½ a τ² matches it at dt.
+                let a = 2.0 * (slip * direction - v0 * dt) / (dt * dt);
+                if v0 > 0.0 && a < 0.0 {
+                    -v0 / a / dt
+                } else {
+                    1.0
+                }
+            }
+        }
+        (ContactState::Open, _) if c.gap0 > 0.0 && gap_end < 0.0 => c.gap0 / (c.gap0 - gap_end),
+        _ => 1.0,
+    };
+    if theta.is_finite() {
+        theta.clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
+
+/// The shear spring stretch of a contact that ends the step in `state`: the yield stretch
+/// ±ρN/p_s when sliding, 0 when open, `None` when locked (the stretch is then whatever the
+/// step left).
+pub(super) fn yield_stretch(c: &Contact, state: ContactState, gap_end: f64) -> Option<f64> {
+    match state {
+        ContactState::Open => Some(0.0),
+        ContactState::Locked => None,
+        ContactState::Sliding { direction } => {
+            let n = c.props.normal_penalty * (-gap_end).max(0.0);
+            let f = if c.props.friction.is_finite() {
+                c.props.friction * n
+            } else {
+                0.0
+            };
+            Some(direction * f / c.props.shear_penalty)
+        }
+    }
+}

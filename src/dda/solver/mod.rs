@@ -1,0 +1,790 @@
+//! The DDA model (`Dda`): its state, construction and accessors. The work of a step is in
+//! the submodules, one job each.
+
+mod analysis;
+mod events;
+mod iteration;
+mod ledger;
+mod stepping;
+mod system;
+
+use std::sync::Arc;
+
+use nalgebra::DVector;
+use serde::Serialize;
+use smallvec::SmallVec;
+
+use super::assembly::{DofMap, System};
+use super::block::{
+    Block, BlockRole, Vec6, displacement_with_rotation, point_displacement, rotation_of,
+    t_transpose_times,
+};
+use super::contact::{
+    self, Contact, ContactMemories, ContactMemory, ContactPair, JointProps, dot6,
+};
+use super::energy::EnergyTerms;
+use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
+use super::judge::{ContactState, JudgeInput, judge};
+use super::linear::{BlockPattern, LinearSolver, SolveError, TINY_LIMIT};
+use super::params::{AlphaCoefficients, SolverParams};
+use crate::ground_motion::GroundMotion;
+use crate::model::geometry::{self, Point};
+use crate::model::scene::{FixedDirection, GroundKind, Scene};
+use crate::{Error, Result};
+
+/// Per-block values of one step (increments, velocities, centroids), inline for models of
+/// up to four blocks: a two-block step is a few microseconds, and the heap traffic of a
+/// handful of small vectors per step was 4 % of it. Larger models spill to the heap.
+type PerBlock<T> = SmallVec<[T; 4]>;
+
+/// State changes of one contact within one step after which its state is kept.
+const MAX_FLIPS_PER_STEP: u32 = 4;
+
+/// A constant point load carried by a block.
+#[derive(Debug, Clone)]
+struct PointLoad {
+    block: usize,
+    point: Point,
+    force: Point,
+}
+
+/// What happened in one accepted step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StepReport {
+    /// Time at the end of the step, s.
+    pub time: f64,
+    /// Step size actually used, s.
+    pub dt: f64,
+    /// Open-close passes in the accepted attempt.
+    pub passes: usize,
+    /// Δt cuts before the step was accepted.
+    pub cuts: usize,
+    /// Contacts found by the search.
+    pub contacts: usize,
+    /// Closed contacts.
+    pub closed: usize,
+    /// Sliding contacts.
+    pub sliding: usize,
+    /// Largest penetration of a closed contact / structure size.
+    pub max_penetration_ratio: f64,
+    /// Largest vertex displacement relative to the ground / structure size.
+    pub max_displacement_ratio: f64,
+    /// Energy terms after the step.
+    pub energy: EnergyTerms,
+}
+
+/// Natural frequencies and mode shapes (see [`Dda::modes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modes {
+    /// Frequencies, Hz, ascending.
+    pub frequencies_hz: Vec<f64>,
+    /// Mode shapes: per mode, per block, the six unknowns (M-normalised).
+    pub shapes: Vec<Vec<Vec6>>,
+}
+
+/// Totals over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct RunCounters {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Open-close passes in accepted attempts.
+    pub passes: u64,
+    /// Δt cuts.
+    pub cuts: u64,
+    /// Largest penetration / structure size seen.
+    pub max_penetration_ratio: f64,
+    /// Largest |energy residual| relative to the energy scale seen so far.
+    pub max_energy_residual_rel: f64,
+    /// Linear systems solved (one per open-close pass).
+    pub linear_solves: u64,
+    /// Numeric factorisations of the system matrix (the rest were solved by conjugate
+    /// gradients preconditioned with a kept factor).
+    pub factorizations: u64,
+    /// Conjugate-gradient iterations with a kept factor.
+    pub cg_iterations: u64,
+    /// Augmented-Lagrangian solves (one per multiplier update).
+    pub constraint_iterations: u64,
+}
+
+/// Which linear problem an iteration solves.
+#[derive(Debug, Clone, Copy)]
+enum Mode {
+    /// A dynamic step of size dt.
+    Dynamic { dt: f64 },
+    /// Static equilibrium under gravity and loads, with every joint's friction coefficient
+    /// replaced by `friction` when given (0: free to slip, ∞: held stuck).
+    Static {
+        /// Friction coefficient used instead of the joints' own.
+        friction: Option<f64>,
+    },
+    /// The bare stiffness, for modal analysis.
+    Modal,
+}
+
+/// Node motion of the current step (for moving joint nodes with their blocks).
+struct StepMotion<'a> {
+    centroids: &'a [Point],
+    increments: &'a [Vec6],
+    /// Each block's rotation as (sine, cosine): the exact rotation's, or `(r0, 1)` for
+    /// the linear map. Computed once per block, not per node (a frame has ~150 nodes).
+    rotations: &'a [(f64, f64)],
+}
+
+impl NodeMotion for StepMotion<'_> {
+    fn node_displacement(&self, b: usize, x: Point) -> Point {
+        displacement_with_rotation(self.centroids[b], x, &self.increments[b], self.rotations[b])
+    }
+
+    fn linear_node_displacement(&self, b: usize, x: Point) -> Point {
+        super::block::point_displacement(self.centroids[b], x, &self.increments[b])
+    }
+}
+
+/// The DDA model of a scene, advancing in time.
+#[derive(Debug, Clone)]
+pub struct Dda {
+    blocks: Vec<Block>,
+    ground: usize,
+    dofs: DofMap,
+    /// Which blocks can couple in the system matrix (fixed for the run).
+    pattern: Arc<BlockPattern>,
+    /// Cholesky solver keeping its symbolic analysis and last factor.
+    linear: LinearSolver,
+    /// The system of the current open-close pass (kept to reuse its storage).
+    pass_system: Option<System>,
+    /// The step's system without contacts (kept to reuse its storage).
+    base_system: Option<System>,
+    /// The step's joint terms (kept to reuse their storage).
+    elements: Vec<ElementTerms>,
+    pairs: Vec<ContactPair>,
+    contacts: Vec<Contact>,
+    memory: ContactMemories,
+    bolts: Vec<Bolt>,
+    fixed: Vec<FixedPoint>,
+    connections: Vec<Connection>,
+    loads: Vec<PointLoad>,
+    motion: Option<GroundMotion>,
+    gravity: f64,
+    params: SolverParams,
+    coeffs: AlphaCoefficients,
+    time: f64,
+    dt_current: f64,
+    structure_size: f64,
+    search_distance: f64,
+    energy: EnergyTerms,
+    stored_reference: f64,
+    energy_scale: f64,
+    counters: RunCounters,
+    last: StepReport,
+    /// How the next step restarts the integrator after a contact event (if at all).
+    restart: Restart,
+    /// When the last step was landed on an event.
+    last_landing: f64,
+    /// The states contacts take at the event a shortened step is landed on.
+    pending_events: Vec<(contact::ContactKey, ContactState)>,
+    /// The stored accelerations are not yet those of the forces (a model that starts
+    /// out of equilibrium): the first event resolution computes them.
+    initial_accel_pending: bool,
+}
+
+/// xᵀ M y for a block's 6×6 matrix.
+fn quadratic(m: &super::block::Mat6, x: &Vec6, y: &Vec6) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..6 {
+        for j in 0..6 {
+            sum += x[i] * m[i][j] * y[j];
+        }
+    }
+    sum
+}
+
+/// Which state of the blocks a projection acts on.
+#[derive(Clone, Copy)]
+enum Field {
+    Velocity,
+    Response,
+}
+
+impl Field {
+    fn of(self, b: &Block) -> Vec6 {
+        match self {
+            Field::Velocity => b.velocity,
+            Field::Response => b.response_accel,
+        }
+    }
+
+    fn of_mut(self, b: &mut Block) -> &mut Vec6 {
+        match self {
+            Field::Velocity => &mut b.velocity,
+            Field::Response => &mut b.response_accel,
+        }
+    }
+}
+
+/// How a step restarts the time integrator after a contact event.
+///
+/// At an event the acceleration jumps (a raft that stops or reverses, a corner that hits
+/// the ground); a second-order scheme carries the old acceleration into the new step and
+/// misjudges the contact right at the event. A restart takes the step with a scheme that
+/// does not use the old acceleration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Restart {
+    /// No event: the chosen integrator.
+    None,
+    /// A stick-slip event: the classic scheme (β = ½, γ = 1), whose end-of-step state does
+    /// not depend on the old acceleration.
+    Event,
+    /// A contact closes (an impact): backward Euler on the velocities (v₁ = v₀ + Δt a₁,
+    /// D = Δt v₁), which brings the approach velocity of the hitting vertex to zero within
+    /// the step — a plastic impact, as of a rigid block on rigid ground (and, for a
+    /// rocking block, exactly Housner's impact: angular momentum about the hitting corner
+    /// is kept). The classic scheme would instead reverse the approach velocity (an elastic
+    /// bounce), and the chosen scheme would add energy with the impulse's acceleration.
+    /// The step after it restarts with [`Restart::AfterImpact`] to flush the impulse.
+    Impact,
+    /// The step after an impact: the classic scheme, like [`Restart::Event`]; the energy
+    /// it removes (the ringing of the springs and blocks just hit) still counts as the
+    /// impact's loss.
+    AfterImpact,
+}
+
+impl Dda {
+    /// Builds the model of `scene` driven by `motion` (None: gravity only).
+    ///
+    /// With `params.initial_equilibrium` the model first settles statically under gravity,
+    /// so the dynamic run starts at rest with the penalty springs already carrying the
+    /// weight.
+    pub fn new(scene: &Scene, motion: Option<GroundMotion>, params: SolverParams) -> Result<Self> {
+        scene.validate()?;
+        params.validate()?;
+        let ground = scene.block_index(&scene.ground.block)?;
+        let mut blocks = Vec::with_capacity(scene.blocks.len());
+        for (i, b) in scene.blocks.iter().enumerate() {
+            let role = match (i == ground, scene.ground.kind) {
+                (false, _) => BlockRole::Free,
+                (true, GroundKind::Prescribed) => BlockRole::PrescribedGround,
+                (true, GroundKind::LargeMass) => BlockRole::LargeMassGround,
+            };
+            let mut block = Block::new(&b.name, b.vertices.clone(), b.material, role)?;
+            block.rigid = b.rigid;
+            blocks.push(block);
+        }
+        let structure: Vec<Point> = blocks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != ground)
+            .flat_map(|(_, b)| b.vertices.iter().copied())
+            .collect();
+        let structure_size = geometry::bounding_size(&structure);
+        let structure_mass: f64 = blocks
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != ground)
+            .map(|(_, b)| b.total_mass())
+            .sum();
+
+        let mut fixed = Vec::new();
+        if scene.ground.kind == GroundKind::LargeMass {
+            // The paper's ground: mass ratio × the structure, on vertical rollers at its two
+            // lowest extreme corners (free to move horizontally, no rotation or bounce).
+            let g = &mut blocks[ground];
+            let target = scene.ground.mass_ratio * structure_mass;
+            g.material.density = target / g.moments.area;
+            g.mass = super::block::mass_matrix(g.material.density, &g.moments);
+            let left = g
+                .vertices
+                .iter()
+                .copied()
+                .fold([f64::INFINITY, 0.0], |m, p| if p[0] < m[0] { p } else { m });
+            let right = g
+                .vertices
+                .iter()
+                .copied()
+                .fold(
+                    [f64::NEG_INFINITY, 0.0],
+                    |m, p| if p[0] > m[0] { p } else { m },
+                );
+            let penalty = 100.0 * g.material.youngs_modulus;
+            for p in [left, right] {
+                fixed.push(FixedPoint {
+                    block: ground,
+                    point: p,
+                    anchor: p,
+                    direction: FixedDirection::Y,
+                    penalty,
+                });
+            }
+        }
+        for f in &scene.fixed_points {
+            let b = scene.block_index(&f.block)?;
+            let penalty = f
+                .penalty
+                .unwrap_or(100.0 * blocks[b].material.youngs_modulus);
+            fixed.push(FixedPoint {
+                block: b,
+                point: f.point,
+                anchor: f.point,
+                direction: f.direction,
+                penalty,
+            });
+        }
+
+        let mut pairs = Vec::new();
+        for c in &scene.contacts {
+            let a = scene.block_index(&c.blocks[0])?;
+            let b = scene.block_index(&c.blocks[1])?;
+            let e = blocks[a]
+                .material
+                .youngs_modulus
+                .max(blocks[b].material.youngs_modulus);
+            let normal = c.normal_penalty.unwrap_or(100.0 * e);
+            let shear = c.shear_penalty.unwrap_or(normal / 2.5);
+            pairs.push(ContactPair {
+                blocks: [a, b],
+                props: JointProps {
+                    friction: c.friction,
+                    normal_penalty: normal,
+                    shear_penalty: shear,
+                    bonded: c.bonded,
+                    locate_events: c.locate_events,
+                },
+            });
+        }
+        let mut bolts = Vec::new();
+        for b in &scene.bolts {
+            let i = scene.block_index(&b.blocks[0])?;
+            let j = scene.block_index(&b.blocks[1])?;
+            bolts.push(Bolt {
+                name: b.name.clone(),
+                blocks: [i, j],
+                points: b.points,
+                rest: geometry::sub(b.points[1], b.points[0]),
+                stiffness: b.stiffness,
+                kind: b.kind,
+            });
+        }
+        let mut connections = Vec::new();
+        for c in &scene.connections {
+            let mut owners = [0; 3];
+            for k in 0..3 {
+                owners[k] = scene.block_index(&c.nodes[k].block)?;
+            }
+            connections.push(Connection {
+                blocks: owners,
+                nodes: [c.nodes[0].point, c.nodes[1].point, c.nodes[2].point],
+                elasticity: c.material.elasticity(),
+                strain: [0.0; 3],
+                stress: [0.0; 3],
+            });
+        }
+        let mut loads = Vec::new();
+        for l in &scene.point_loads {
+            loads.push(PointLoad {
+                block: scene.block_index(&l.block)?,
+                point: l.point,
+                force: l.force,
+            });
+        }
+        let is_free: Vec<bool> = blocks
+            .iter()
+            .map(|b| b.role != BlockRole::PrescribedGround)
+            .collect();
+        let dofs = DofMap::new(&is_free);
+        let pattern = Arc::new(coupling_pattern(
+            &dofs,
+            &pairs,
+            &bolts,
+            &fixed,
+            &connections,
+        ));
+        let linear = LinearSolver::new(Arc::clone(&pattern)).map_err(|e| Error::Solver {
+            time: 0.0,
+            reason: format!("cannot analyse the system matrix: {e:?}"),
+        })?;
+        let mut model = Self {
+            blocks,
+            ground,
+            dofs,
+            pattern,
+            linear,
+            pass_system: None,
+            base_system: None,
+            elements: Vec::new(),
+            pairs,
+            contacts: Vec::new(),
+            memory: ContactMemories::default(),
+            bolts,
+            fixed,
+            connections,
+            loads,
+            motion,
+            gravity: scene.gravity,
+            coeffs: params.integrator.coefficients(),
+            dt_current: params.dt,
+            search_distance: 2.5 * params.max_displacement_ratio * structure_size,
+            params,
+            time: 0.0,
+            structure_size,
+            energy: EnergyTerms::default(),
+            stored_reference: 0.0,
+            energy_scale: 0.0,
+            counters: RunCounters::default(),
+            last: StepReport::default(),
+            restart: Restart::None,
+            last_landing: f64::NEG_INFINITY,
+            pending_events: Vec::new(),
+            initial_accel_pending: false,
+        };
+        model.check_initial_overlap()?;
+        if model.params.initial_equilibrium {
+            model.settle()?;
+        } else {
+            // The stored accelerations (zero) are not those of the initial forces: the
+            // first step restarts, so that it does not depend on them.
+            model.restart = Restart::Event;
+            model.initial_accel_pending = true;
+        }
+        model.reset_reference();
+        Ok(model)
+    }
+
+    /// Finds the contacts of the current geometry (carrying over the memory of the last
+    /// step's).
+    fn detect_contacts(&mut self) {
+        contact::detect(
+            &self.blocks,
+            &self.pairs,
+            &self.memory,
+            self.search_distance,
+            &mut self.contacts,
+        );
+        if self.augmented() {
+            self.scale_constraint_penalties();
+        }
+    }
+
+    /// With the augmented Lagrangian the penalties only set how fast the multipliers
+    /// converge: each iteration shrinks the constraint violation by about k/(k + p), k
+    /// the stiffness the contact sees (inertia M/(βΔt²) or block elasticity). They are
+    /// raised to 1e4 times that, so that a few iterations reach round-off, yet not so
+    /// far that the factorisation loses the soft directions (1e-16 · p/k).
+    fn scale_constraint_penalties(&mut self) {
+        const FACTOR: f64 = 1e4;
+        let mass_factor = self.inertia_stiffness_factor();
+        let stiffness = |b: &Block| {
+            if b.role == BlockRole::PrescribedGround {
+                0.0
+            } else {
+                (mass_factor * b.total_mass()).max(b.material.youngs_modulus)
+            }
+        };
+        for c in &mut self.contacts {
+            let k = stiffness(&self.blocks[c.key.vertex_block])
+                .max(stiffness(&self.blocks[c.key.edge_block]));
+            c.props.normal_penalty = c.props.normal_penalty.max(FACTOR * k);
+            c.props.shear_penalty = c.props.normal_penalty;
+        }
+    }
+
+    /// The stiffness a unit mass shows over a full step, 1/(βΔt²): what the constraint
+    /// penalties are measured against.
+    fn inertia_stiffness_factor(&self) -> f64 {
+        1.0 / (self.coeffs.beta * self.params.dt * self.params.dt)
+    }
+
+    /// Starts the friction of each closed contact from its normal force extrapolated over
+    /// this step of `dt` (rather than the force at the step start): the open-close
+    /// iteration repeats a pass until the friction force uses the normal force the pass
+    /// finds, and a sliding frame's normal forces change by more than that tolerance
+    /// (1e-4) in most steps. The prediction is O(Δt²) close and saves the extra pass
+    /// (three-storey frame on El Centro: 1.40 passes per step before, 1.02 with it).
+    fn predict_friction_normals(&mut self, dt: f64) {
+        let previous_dt = self.last.dt;
+        if previous_dt <= 0.0 {
+            return;
+        }
+        let augmented = self.augmented();
+        for c in &mut self.contacts {
+            if c.start_state.is_closed() {
+                let predicted = c.start_normal + c.previous_normal_change * dt / previous_dt;
+                c.friction_normal = predicted.max(0.0);
+                // The multipliers start from the same prediction: the first solve then
+                // misses the constraint by O(Δt²) of the force, not O(Δt).
+                if augmented {
+                    c.normal_multiplier = predicted;
+                    if c.start_state == ContactState::Locked {
+                        c.shear_multiplier =
+                            c.start_shear_multiplier + c.previous_shear_change * dt / previous_dt;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Refuses a scene whose blocks overlap at the start by more than a rounding error of
+    /// the geometry: the penalty springs would throw them apart with an energy the scene
+    /// never had (a vertex 1 cm inside a block on a 1e12 N/m spring stores 50 MJ).
+    fn check_initial_overlap(&mut self) -> Result<()> {
+        let tolerance = 1e-6 * self.structure_size;
+        self.detect_contacts();
+        let worst = self
+            .contacts
+            .iter()
+            .filter(|c| !c.props.bonded)
+            .min_by(|a, b| a.gap0.total_cmp(&b.gap0));
+        match worst {
+            Some(c) if c.gap0 < -tolerance => Err(Error::Scene(format!(
+                "blocks overlap at the start: vertex {} of block '{}' at ({:.6}, {:.6}) lies \
+                 {:.3e} m inside block '{}' (edge {}); move the blocks apart so that they only \
+                 touch",
+                c.key.vertex,
+                self.blocks[c.key.vertex_block].name,
+                c.point[0],
+                c.point[1],
+                -c.gap0,
+                self.blocks[c.key.edge_block].name,
+                c.key.edge
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The blocks in scene order.
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+
+    /// Index of the ground block.
+    pub fn ground(&self) -> usize {
+        self.ground
+    }
+
+    /// Contacts of the last step (geometry at its start, state at its end).
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    /// The forces a contact of the last step carries: (normal force, compressive
+    /// positive; tangential pull, N — the force the stick resists or friction opposes,
+    /// positive along the edge tangent).
+    pub fn contact_force(&self, c: &Contact) -> (f64, f64) {
+        let normal = if !c.state.is_closed() {
+            0.0
+        } else if self.augmented() {
+            c.normal_multiplier
+        } else {
+            c.friction_normal
+        };
+        let tangential = match c.state {
+            ContactState::Open => 0.0,
+            ContactState::Locked if self.augmented() => -c.shear_multiplier,
+            ContactState::Locked => c.props.shear_penalty * c.shear0,
+            ContactState::Sliding { direction } => {
+                direction * c.props.friction.min(1e30) * c.friction_normal
+            }
+        };
+        (normal, tangential)
+    }
+
+    /// Bolts with their current end points.
+    pub fn bolts(&self) -> &[Bolt] {
+        &self.bolts
+    }
+
+    /// Connection elements with their current nodes.
+    pub fn connections(&self) -> &[Connection] {
+        &self.connections
+    }
+
+    /// Energy terms now.
+    pub fn energy(&self) -> EnergyTerms {
+        self.energy
+    }
+
+    /// Number of unknowns of the system (6 per free block).
+    pub fn unknowns(&self) -> usize {
+        self.dofs.n
+    }
+
+    /// Run totals.
+    pub fn counters(&self) -> RunCounters {
+        let linear = self.linear.stats();
+        RunCounters {
+            linear_solves: linear.solves,
+            factorizations: linear.factorizations,
+            cg_iterations: linear.iterations,
+            ..self.counters
+        }
+    }
+
+    /// The last step's report.
+    pub fn last_report(&self) -> StepReport {
+        self.last
+    }
+
+    /// Solver parameters.
+    pub fn params(&self) -> &SolverParams {
+        &self.params
+    }
+
+    /// Size of the structure (bounding diagonal of all blocks but the ground), m.
+    pub fn structure_size(&self) -> f64 {
+        self.structure_size
+    }
+
+    /// Index of a block by name.
+    pub fn block_index(&self, name: &str) -> Result<usize> {
+        self.blocks
+            .iter()
+            .position(|b| b.name == name)
+            .ok_or_else(|| Error::Scene(format!("unknown block '{name}'")))
+    }
+
+    /// Horizontal displacement of block `b`'s centroid relative to the ground's, m (the
+    /// slip of a base block), since the reference state.
+    pub fn displacement_relative_to_ground(&self, b: usize) -> f64 {
+        self.blocks[b].centroid_displacement()[0]
+            - self.blocks[self.ground].centroid_displacement()[0]
+    }
+
+    /// Absolute horizontal acceleration of block `b`'s centroid now, m/s²: the model
+    /// moves with the ground (see [`Dda::frame_displacement`]), so the ground's
+    /// acceleration is added to the block's.
+    pub fn absolute_accel(&self, b: usize) -> f64 {
+        self.blocks[b].response_accel[0] + self.ground_accel(self.time)
+    }
+
+    /// How far the model's frame has moved with the ground, m: the solver works in a
+    /// frame that translates with the input ground motion (every block feels −m ü0), so
+    /// absolute positions are the blocks' plus this.
+    pub fn frame_displacement(&self) -> f64 {
+        self.motion
+            .as_ref()
+            .map_or(0.0, |m| m.displacement(self.time))
+    }
+
+    /// Ground acceleration at time t (the input, not the large-mass ground's response).
+    pub fn ground_accel(&self, t: f64) -> f64 {
+        self.motion.as_ref().map_or(0.0, |m| m.accel(t))
+    }
+
+    /// Zeroes the strain entries of rigid blocks in a change of the right-hand side.
+    fn hold_rigid_change(&self, change: &mut [f64]) {
+        for (b, slot) in self.blocks.iter().zip(&self.dofs.slot) {
+            if let (true, Some(s)) = (b.rigid, *slot) {
+                change[s + 3..s + 6].fill(0.0);
+            }
+        }
+    }
+
+    /// Holds the strain unknowns of rigid blocks at zero in `sys`.
+    fn hold_rigid_strains(&self, sys: &mut System) {
+        for (b, slot) in self.blocks.iter().zip(&self.dofs.slot) {
+            if let (true, Some(s)) = (b.rigid, *slot) {
+                sys.hold_strains(s);
+            }
+        }
+    }
+
+    fn augmented(&self) -> bool {
+        self.params.contact_enforcement == super::params::ContactEnforcement::AugmentedLagrangian
+    }
+
+    /// Whether block `b` moves in the model's frame (everything but a prescribed
+    /// ground, which stands still in it): the energy balance is the balance of these.
+    fn is_structure(&self, b: usize) -> bool {
+        self.blocks[b].role != BlockRole::PrescribedGround
+    }
+
+    /// The blocks' centroids at the step start, the origins of their unknowns (a copy,
+    /// so that the blocks can be moved while it is read).
+    fn centroids(&self) -> PerBlock<Point> {
+        self.blocks.iter().map(|b| b.moments.centroid).collect()
+    }
+
+    /// Known increments of the blocks without unknowns: none move, since the model moves
+    /// with the ground (see [`Dda::frame_displacement`]): a prescribed ground stands still
+    /// in it, and the ground's acceleration acts on every block as a body force instead.
+    fn known_increments(&self) -> PerBlock<Vec6> {
+        PerBlock::from_elem([0.0; 6], self.blocks.len())
+    }
+
+    /// Sets the velocity of block `b`'s six unknowns (an initial condition: call before
+    /// the first step).
+    pub fn set_velocity(&mut self, b: usize, velocity: Vec6) -> Result<()> {
+        let block = self
+            .blocks
+            .get_mut(b)
+            .ok_or_else(|| Error::invalid("block index", format!("{b} is out of range")))?;
+        if velocity.iter().any(|v| !v.is_finite()) {
+            return Err(Error::invalid("velocity", "must be finite"));
+        }
+        block.velocity = velocity;
+        Ok(())
+    }
+
+    /// Advances until `t_end`, calling `observe` after every step.
+    pub fn run_until(
+        &mut self,
+        t_end: f64,
+        mut observe: impl FnMut(&Dda, &StepReport),
+    ) -> Result<()> {
+        while self.time < t_end - 1e-9 * self.params.dt {
+            let report = self.step(t_end - self.time)?;
+            observe(self, &report);
+        }
+        Ok(())
+    }
+}
+
+/// Adds a scalar contact force `amount`, acting along a contact's gradients on its two
+/// blocks, to the generalised forces `rhs` (blocks without unknowns take none).
+fn spread_force(dofs: &DofMap, rhs: &mut [f64], amount: f64, sides: [(usize, &Vec6); 2]) {
+    for (block, grad) in sides {
+        if let Some(s) = dofs.slot[block] {
+            for k in 0..6 {
+                rhs[s + k] += amount * grad[k];
+            }
+        }
+    }
+}
+
+/// The block couplings the system matrix can have: joints between their blocks, and each
+/// declared contact pair (the only blocks contacts are searched between).
+fn coupling_pattern(
+    dofs: &DofMap,
+    pairs: &[ContactPair],
+    bolts: &[Bolt],
+    fixed: &[FixedPoint],
+    connections: &[Connection],
+) -> BlockPattern {
+    let free = |b: usize| dofs.slot[b].map(|s| s / 6);
+    let mut couplings = Vec::new();
+    let mut tie = |blocks: &[usize]| {
+        for &a in blocks {
+            for &b in blocks {
+                if let (Some(i), Some(j)) = (free(a), free(b)) {
+                    couplings.push((i, j));
+                }
+            }
+        }
+    };
+    for p in pairs {
+        tie(&p.blocks);
+    }
+    for b in bolts {
+        tie(&b.blocks);
+    }
+    for f in fixed {
+        tie(&[f.block]);
+    }
+    for c in connections {
+        tie(&c.blocks);
+    }
+    BlockPattern::new(dofs.n / 6, couplings)
+}

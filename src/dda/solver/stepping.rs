@@ -1,0 +1,518 @@
+//! The step controller: Δt cuts, event landing, integrator restarts, and the commit of a converged step (integrator update, energy booking, geometry).
+
+use super::iteration::yield_stretch;
+use super::*;
+
+impl Dda {
+    /// Largest vertex displacement of the structure relative to the ground translation,
+    /// as a fraction of the structure size.
+    pub(super) fn max_relative_displacement(&self, increments: &[Vec6], _known: &[Vec6]) -> f64 {
+        self.most_displaced_block(increments).1
+    }
+
+    /// The block with the largest vertex displacement relative to the ground translation,
+    /// and that displacement as a fraction of the structure size.
+    pub(super) fn most_displaced_block(&self, increments: &[Vec6]) -> (usize, f64) {
+        let g = increments[self.ground];
+        // Squared lengths compared, one square root at the end (this runs every step).
+        let mut max = (self.ground, 0.0_f64);
+        for (bi, b) in self.blocks.iter().enumerate() {
+            if bi == self.ground {
+                continue;
+            }
+            for &p in &b.vertices {
+                let u = point_displacement(b.moments.centroid, p, &increments[bi]);
+                let (dx, dy) = (u[0] - g[0], u[1] - g[1]);
+                let d2 = dx * dx + dy * dy;
+                if d2 > max.1 {
+                    max = (bi, d2);
+                }
+            }
+        }
+        (max.0, max.1.sqrt() / self.structure_size)
+    }
+
+    /// Moves blocks and joints by the increments and updates the contact memory.
+    pub(super) fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
+        let centroids = self.centroids();
+        let rotations: PerBlock<(f64, f64)> = increments
+            .iter()
+            .map(|d| rotation_of(d, self.params.exact_rotation))
+            .collect();
+        let motion = StepMotion {
+            centroids: &centroids,
+            increments,
+            rotations: &rotations,
+        };
+        for b in &mut self.bolts {
+            b.commit(&motion);
+        }
+        for f in &mut self.fixed {
+            f.commit(&motion);
+        }
+        for c in &mut self.connections {
+            c.commit(&motion);
+        }
+        for l in &mut self.loads {
+            let u = motion.node_displacement(l.block, l.point);
+            l.point[0] += u[0];
+            l.point[1] += u[1];
+        }
+        for (b, d) in self.blocks.iter_mut().zip(increments) {
+            b.apply_increment(d, self.params.exact_rotation)?;
+        }
+        self.memory.clear();
+        let augmented = self.augmented();
+        for c in &self.contacts {
+            let di = &increments[c.key.vertex_block];
+            let dj = &increments[c.key.edge_block];
+            let gap = c.gap_end(di, dj);
+            let stuck_stretch = c.shear0 + c.slip_increment(di, dj);
+            let (shear, normal_force, shear_multiplier) = if augmented {
+                // The stretch left is the constraint's residual (round-off), kept so the
+                // next step pulls it back; a sliding contact carries its friction force
+                // as the multiplier it sticks with.
+                let normal = if c.state.is_closed() {
+                    c.normal_multiplier
+                } else {
+                    0.0
+                };
+                match c.state {
+                    ContactState::Open => (0.0, 0.0, 0.0),
+                    ContactState::Locked => (stuck_stretch, normal, c.shear_multiplier),
+                    ContactState::Sliding { direction } => {
+                        let mu = if c.props.friction.is_finite() {
+                            c.props.friction
+                        } else {
+                            0.0
+                        };
+                        (0.0, normal, -direction * mu * normal.max(0.0))
+                    }
+                }
+            } else {
+                (
+                    yield_stretch(c, c.state, gap).unwrap_or(stuck_stretch),
+                    c.props.normal_penalty * (-gap).max(0.0),
+                    0.0,
+                )
+            };
+            self.memory.insert(
+                c.key,
+                ContactMemory {
+                    state: c.state,
+                    shear,
+                    normal_force,
+                    normal_change: if c.start_state.is_closed() && c.state.is_closed() {
+                        normal_force - c.start_normal
+                    } else {
+                        0.0
+                    },
+                    shear_change: if c.start_state == ContactState::Locked
+                        && c.state == ContactState::Locked
+                    {
+                        shear_multiplier - c.start_shear_multiplier
+                    } else {
+                        0.0
+                    },
+                    shear_multiplier,
+                },
+            );
+        }
+        Ok(())
+    }
+
+    /// Advances one step (of at most `max_dt`), cutting Δt as needed.
+    pub fn step(&mut self, max_dt: f64) -> Result<StepReport> {
+        // The step after a landing on a contact event restarts the integrator (see
+        // [`Restart`]).
+        let scheme = self.coeffs;
+        // An event at the very start of a step asks once for a restart; a second request
+        // in the same step (restarts disabled, or the restart found the same event) is
+        // taken as it comes, so a step always ends.
+        let mut may_restart = self.params.restart_after_events;
+        loop {
+            let restart = if self.params.restart_after_events {
+                self.restart
+            } else {
+                Restart::None
+            };
+            match restart {
+                Restart::None => {}
+                // With exact constraints a stick-slip event need not change the integrator:
+                // the velocities and accelerations are made consistent with the new
+                // contact states. An impact still restarts with backward Euler: projecting
+                // the impulse puts energy into a deformable block's unresolved strain
+                // modes, which the chosen scheme then amplifies (a toppling block gained
+                // 20 kJ in one step); backward Euler removes it as the impact's loss.
+                Restart::Event if self.augmented() => self.resolve_event()?,
+                Restart::Event | Restart::AfterImpact => {
+                    self.coeffs = crate::dda::params::Integrator::Classic.coefficients();
+                }
+                Restart::Impact => {
+                    // Newmark β = γ = 1 with the old acceleration taken as zero is backward
+                    // Euler: D = Δt v₀ + Δt² a₁, v₁ = v₀ + Δt a₁.
+                    self.coeffs = AlphaCoefficients {
+                        alpha_m: 0.0,
+                        alpha_f: 0.0,
+                        beta: 1.0,
+                        gamma: 1.0,
+                    };
+                    for b in &mut self.blocks {
+                        if b.role != BlockRole::PrescribedGround {
+                            b.accel = [0.0; 6];
+                        }
+                    }
+                }
+            }
+            let result = self.step_with_current_scheme(max_dt, restart, may_restart);
+            self.coeffs = scheme;
+            match result {
+                Ok(Some(report)) => return Ok(report),
+                // An event right at the step start: redo the step as a restart.
+                Ok(None) => may_restart = false,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// One step with the current coefficients (`restart` says how this step restarts the
+    /// integrator); `Ok(None)` asks for a restart (an event at the very start of the step
+    /// was found; only when `may_restart`).
+    pub(super) fn step_with_current_scheme(
+        &mut self,
+        max_dt: f64,
+        restart: Restart,
+        may_restart: bool,
+    ) -> Result<Option<StepReport>> {
+        let mut cuts = 0;
+        let dt_min = self.params.dt * self.params.min_dt_fraction;
+        let mut dt_override: Option<f64> = None;
+        // How the step after this one restarts, when this one is landed on an event.
+        let mut event_kind = Restart::Event;
+        loop {
+            let dt = dt_override.unwrap_or(self.dt_current).min(max_dt);
+            let mode = Mode::Dynamic { dt };
+            let known = self.known_increments();
+            self.detect_contacts();
+            self.predict_friction_normals(dt);
+            let outcome = self.iterate(mode, &known)?;
+            // Land the step on a stick-slip (or impact) event: a transition assumed at the
+            // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
+            // A restart step accepts the stick-slip transitions it meets (it starts at one,
+            // and must not creep up on it) but still lands on a further impact: a contact
+            // that closes inside a backward-Euler step would leave it with the velocity
+            // that closes the gap, which the next step would turn into a bounce.
+            // At most one landing per nominal step: with many contacts some contact has
+            // an event in nearly every step (blocks that touch at zero force chatter
+            // between stuck, sliding and open), and landing on each would cut the steps to
+            // nothing; the events between landings are taken at the step ends.
+            let may_land = self.time - self.last_landing >= self.params.dt * (1.0 - 1e-9);
+            if outcome.is_some()
+                && self.params.locate_events
+                && dt_override.is_none()
+                && (may_land || restart != Restart::None)
+            {
+                let (theta, impact) = self
+                    .contacts
+                    .iter()
+                    .filter(|c| c.props.locate_events)
+                    .map(|c| {
+                        let theta = c.event_fraction_in_step();
+                        (theta, c.start_state == ContactState::Open && theta < 1.0)
+                    })
+                    .filter(|&(_, impact)| restart == Restart::None || impact)
+                    .fold((1.0_f64, false), |a, b| if b.0 < a.0 { b } else { a });
+                event_kind = if impact {
+                    Restart::Impact
+                } else {
+                    Restart::Event
+                };
+                let at_start = theta * dt <= 1e-6 * self.params.dt;
+                if at_start && restart == Restart::None && may_restart {
+                    // The event happened at the step start: restart from here.
+                    self.restart = event_kind;
+                    if self.augmented() {
+                        self.adopt_trial_states();
+                    }
+                    return Ok(None);
+                }
+                // (In a restart step, an impact at its very start is part of this step.)
+                if !at_start && theta < 1.0 {
+                    // The states the contacts take at the event: given to them when the
+                    // shortened step ends there (and resolved at the next step's start).
+                    self.pending_events = self
+                        .contacts
+                        .iter()
+                        .filter(|c| {
+                            // Events within a thousandth of the step are one event (the
+                            // two corners of a face stick together).
+                            c.props.locate_events
+                                && (c.event_fraction_in_step() - theta).abs() <= 1e-3
+                        })
+                        .map(|c| {
+                            // A slip that reverses stops first: the event's resolution
+                            // decides whether it sticks or slides back.
+                            let state = match (c.start_state, c.state) {
+                                (ContactState::Sliding { .. }, ContactState::Sliding { .. }) => {
+                                    ContactState::Locked
+                                }
+                                (_, state) => state,
+                            };
+                            (c.key, state)
+                        })
+                        .collect();
+                    if theta < 0.999 {
+                        dt_override = Some(theta * dt);
+                        self.last_landing = self.time + theta * dt;
+                        continue;
+                    }
+                    // The event is at this step's end: the step is landed on it as it is,
+                    // and the next step restarts from the event's states.
+                    dt_override = Some(dt);
+                }
+            }
+            let reason = match outcome {
+                None => format!(
+                    "the open-close iteration did not settle in {} passes",
+                    self.params.max_open_close_passes
+                ),
+                Some((increments, passes)) => {
+                    let ratio = self.max_relative_displacement(&increments, &known);
+                    if ratio <= self.params.max_displacement_ratio {
+                        let report = self.commit_step(
+                            dt,
+                            &increments,
+                            passes,
+                            cuts,
+                            ratio,
+                            matches!(restart, Restart::Impact | Restart::AfterImpact),
+                        )?;
+                        // The step after a landing starts at the event: its transition is
+                        // accepted as it comes, so the solver does not creep up on it. An
+                        // impact step is followed by a classic restart, which does not
+                        // carry the impulse's acceleration on; so is a step in which a
+                        // contact opened (its force dropped within the step, and the old
+                        // acceleration would ring on as a decaying energy error).
+                        let opened = self
+                            .contacts
+                            .iter()
+                            .any(|c| c.start_state.is_closed() && c.state == ContactState::Open);
+                        if self.augmented() && dt_override.is_some() {
+                            for (key, state) in std::mem::take(&mut self.pending_events) {
+                                if let Some(m) = self.memory.get_mut(&key)
+                                    && m.state != state
+                                {
+                                    m.state = state;
+                                    m.shear = 0.0;
+                                    if !state.is_closed() {
+                                        m.normal_force = 0.0;
+                                        m.shear_multiplier = 0.0;
+                                    }
+                                }
+                            }
+                        }
+                        self.restart = match (dt_override.is_some(), restart) {
+                            (true, _) => event_kind,
+                            (false, Restart::Impact) => Restart::AfterImpact,
+                            (false, _) if opened => Restart::Event,
+                            (false, _) => Restart::None,
+                        };
+                        // Grow back towards the nominal step after a cut.
+                        self.dt_current = (self.dt_current * 1.5).min(self.params.dt);
+                        return Ok(Some(report));
+                    }
+                    format!(
+                        "a vertex moved {ratio:.2e} structure sizes in one step (limit {:.2e})",
+                        self.params.max_displacement_ratio
+                    )
+                }
+            };
+            dt_override = None;
+            cuts += 1;
+            self.counters.cuts += 1;
+            self.dt_current *= self.params.cut_factor;
+            if self.dt_current < dt_min {
+                return Err(Error::Solver {
+                    time: self.time,
+                    reason: format!(
+                        "{reason}, even with Δt cut to {:.3e} s; the contact springs may be far too \
+                         stiff or soft for this Δt, or blocks interpenetrate",
+                        dt
+                    ),
+                });
+            }
+        }
+    }
+
+    /// Accepts a converged step: integrator update, energy bookkeeping, geometry.
+    /// `impact`: the step is a plastic impact (or the step right after one), and the
+    /// energy it removes is counted as impact loss.
+    pub(super) fn commit_step(
+        &mut self,
+        dt: f64,
+        increments: &[Vec6],
+        passes: usize,
+        cuts: usize,
+        ratio: f64,
+        impact: bool,
+    ) -> Result<StepReport> {
+        let c = self.coeffs;
+        let t_new = self.time + dt;
+        let start: PerBlock<[Vec6; 2]> = self
+            .blocks
+            .iter()
+            .map(|b| [b.velocity, b.response_accel])
+            .collect();
+        // Newmark update of velocities and accelerations.
+        for (b, d) in self.blocks.iter_mut().zip(increments) {
+            if b.role == BlockRole::PrescribedGround {
+                b.velocity = [0.0; 6];
+                b.accel = [0.0; 6];
+                b.response_accel = [0.0; 6];
+                continue;
+            }
+            for k in 0..6 {
+                let (v0, a0) = (b.velocity[k], b.accel[k]);
+                let a_new = c.end_accel(d[k], v0, a0, dt);
+                b.velocity[k] = c.end_velocity(v0, a0, a_new, dt);
+                b.response_accel[k] = c.balanced_accel(a0, a_new, b.response_accel[k]);
+                b.accel[k] = a_new;
+            }
+        }
+        // The integrator's own dissipation, from its states alone: the work of the average
+        // of the forces at the step's ends (M â, with â the accelerations that balance
+        // them) on the increment, less the change of kinetic energy (both with the step's
+        // mass matrix). Zero for the trapezoidal rule; what the residual leaves is then
+        // the model's own inconsistency, not the scheme's.
+        let mut numerical = 0.0;
+        for ((b, d), [v0, a0]) in self.blocks.iter().zip(increments).zip(&start) {
+            if b.role == BlockRole::PrescribedGround {
+                continue;
+            }
+            let mut a_mean = [0.0; 6];
+            for k in 0..6 {
+                a_mean[k] = 0.5 * (a0[k] + b.response_accel[k]);
+            }
+            numerical += quadratic(&b.mass, &a_mean, d)
+                - 0.5 * quadratic(&b.mass, &b.velocity, &b.velocity)
+                + 0.5 * quadratic(&b.mass, v0, v0);
+        }
+        // Friction and contact counts.
+        let augmented = self.augmented();
+        let mut dissipated = 0.0;
+        let mut max_pen = 0.0_f64;
+        let (mut closed, mut sliding) = (0, 0);
+        for ct in &self.contacts {
+            let (i, j) = (ct.key.vertex_block, ct.key.edge_block);
+            let (di, dj) = (&increments[i], &increments[j]);
+            let gap = ct.gap_end(di, dj);
+            let slip = ct.slip_increment(di, dj);
+            if ct.state.is_closed() {
+                closed += 1;
+                max_pen = max_pen.max(-gap);
+            }
+            if let ContactState::Sliding { direction } = ct.state {
+                sliding += 1;
+                let f = ct.props.friction * ct.friction_normal;
+                dissipated += if augmented {
+                    // The friction force on the vertex, averaged over the step's ends (at
+                    // its start, whatever the contact carried then), times the slip.
+                    -0.5 * (ct.start_shear_multiplier - direction * f) * slip
+                } else {
+                    // Plastic slip: the slip minus the change of the spring's stretch.
+                    let elastic = yield_stretch(ct, ct.state, gap).unwrap_or(0.0) - ct.shear0;
+                    f * (direction * (slip - elastic)).max(0.0)
+                };
+            }
+        }
+        // Contact dashpots: force c·q̇ at the α point times the relative displacement.
+        let mut damped = 0.0;
+        for ct in &self.contacts {
+            let (cn, cs) = self.dashpot_coefficients(ct);
+            let (i, j) = (ct.key.vertex_block, ct.key.edge_block);
+            for (damping, a, b) in [(cn, &ct.gap_i, &ct.gap_j), (cs, &ct.slip_i, &ct.slip_j)] {
+                if damping == 0.0 {
+                    continue;
+                }
+                let q0 = self.directional_velocity(i, a, j, b, &|k| start[k][0]);
+                let q1 = self.directional_velocity(i, a, j, b, &|k| self.blocks[k].velocity);
+                let force = damping * ((1.0 - c.alpha_f) * q1 + c.alpha_f * q0);
+                damped += force * (dot6(a, &increments[i]) + dot6(b, &increments[j]));
+            }
+        }
+        // Work of the loads: gravity and point loads, and the ground's acceleration, which
+        // in the frame moving with the ground is a body force −m ü0 on every block (but
+        // the paper's large-mass ground, whose driving force m_g ü0 cancels it).
+        let centroids = self.centroids();
+        let mut external = 0.0;
+        let mut input = 0.0;
+        let ground_accel = 0.5 * (self.ground_accel(self.time) + self.ground_accel(t_new));
+        for (b, d) in self.blocks.iter().zip(increments) {
+            if b.role == BlockRole::PrescribedGround {
+                continue;
+            }
+            external -= b.total_mass() * self.gravity * d[1];
+            if b.role != BlockRole::LargeMassGround {
+                input -= b.total_mass() * ground_accel * d[0];
+            }
+        }
+        for l in &self.loads {
+            let u = point_displacement(centroids[l.block], l.point, &increments[l.block]);
+            external += l.force[0] * u[0] + l.force[1] * u[1];
+        }
+        self.commit_geometry(increments)?;
+        self.time = t_new;
+
+        let e = &mut self.energy;
+        e.input_work += input;
+        e.external_work += external;
+        e.friction_dissipated += dissipated;
+        e.contact_damping += damped;
+        if impact {
+            // A plastic impact step (penalty contacts): what the scheme removed is the
+            // impact's loss.
+            e.impact_dissipated += numerical;
+        } else {
+            e.numerical_dissipated += numerical;
+        }
+        let kinetic = self.kinetic_energy();
+        let strain = self.stored_energy() - self.stored_reference;
+        self.energy.kinetic = kinetic;
+        self.energy.strain = strain;
+        self.energy_scale = self.energy_scale.max(self.energy.scale());
+        let residual_rel = self.energy_residual_relative().abs();
+        if self.blocks.iter().any(|b| {
+            b.velocity
+                .iter()
+                .chain(b.accel.iter())
+                .any(|v| !v.is_finite())
+        }) {
+            return Err(Error::Solver {
+                time: self.time,
+                reason: "a velocity or acceleration became non-finite".into(),
+            });
+        }
+        let report = StepReport {
+            time: self.time,
+            dt,
+            passes,
+            cuts,
+            contacts: self.contacts.len(),
+            closed,
+            sliding,
+            max_penetration_ratio: max_pen / self.structure_size,
+            max_displacement_ratio: ratio,
+            energy: self.energy,
+        };
+        self.counters.steps += 1;
+        self.counters.passes += passes as u64;
+        self.counters.max_penetration_ratio = self
+            .counters
+            .max_penetration_ratio
+            .max(report.max_penetration_ratio);
+        self.counters.max_energy_residual_rel =
+            self.counters.max_energy_residual_rel.max(residual_rel);
+        self.last = report;
+        Ok(report)
+    }
+}

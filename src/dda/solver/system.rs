@@ -1,0 +1,227 @@
+//! Assembling a step's linear system: elements, contacts, dashpots.
+
+use super::*;
+
+impl Dda {
+    pub(super) fn element_terms(&self) -> Vec<ElementTerms> {
+        let mut out = Vec::new();
+        self.element_terms_into(&mut out);
+        out
+    }
+
+    /// This step's terms of every joint, into `out` (cleared first).
+    pub(super) fn element_terms_into(&self, out: &mut Vec<ElementTerms>) {
+        out.clear();
+        out.extend(self.bolts.iter().map(Bolt::terms));
+        out.extend(self.fixed.iter().map(FixedPoint::terms));
+        out.extend(self.connections.iter().map(Connection::terms));
+    }
+
+    /// Assembles everything that does not depend on contact states (into a new system).
+    pub(super) fn assemble_base(
+        &self,
+        mode: Mode,
+        known: &[Vec6],
+        elements: &[ElementTerms],
+    ) -> System {
+        let mut sys = System::zeros(Arc::clone(&self.pattern), 1.0);
+        self.assemble_base_into(&mut sys, mode, known, elements);
+        sys
+    }
+
+    /// Assembles everything that does not depend on contact states into `sys` (same
+    /// pattern; its values are overwritten).
+    pub(super) fn assemble_base_into(
+        &self,
+        sys: &mut System,
+        mode: Mode,
+        known: &[Vec6],
+        elements: &[ElementTerms],
+    ) {
+        let c = &self.coeffs;
+        let (mass_factor, stiffness_factor) = match mode {
+            Mode::Dynamic { dt } => (c.mass_factor(dt), 1.0 - c.alpha_f),
+            // A vanishing "mass spring" (1 mHz) only so that unloaded rigid-body modes (a
+            // roof hung on one bolt can still turn) do not make the static matrix singular.
+            Mode::Static { .. } => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
+            Mode::Modal => (0.0, 1.0),
+        };
+        sys.clear(stiffness_factor);
+        for (bi, b) in self.blocks.iter().enumerate() {
+            let Some(s) = self.dofs.slot[bi] else {
+                continue;
+            };
+            sys.add_diag_block(s, &b.mass, mass_factor);
+            // Elastic stiffness on the strain unknowns and the initial-stress force.
+            let diagonal = sys.k.diagonal_mut(s / 6);
+            for i in 0..3 {
+                for j in 0..3 {
+                    diagonal[3 + i][3 + j] +=
+                        stiffness_factor * b.moments.area * b.elasticity[i][j];
+                }
+            }
+            for i in 0..3 {
+                sys.r[s + 3 + i] -= b.moments.area * b.stress[i];
+            }
+            // Gravity.
+            sys.r[s + 1] -= b.total_mass() * self.gravity;
+            if let Mode::Dynamic { dt } = mode {
+                // Inertia from the previous step: −M[(1 − αm) ã + αm a].
+                let mut w = [0.0; 6];
+                for k in 0..6 {
+                    w[k] = c.inertia_predictor(b.velocity[k], b.accel[k], dt);
+                }
+                for i in 0..6 {
+                    let mw: f64 = (0..6).map(|j| b.mass[i][j] * w[j]).sum();
+                    sys.r[s + i] -= mw;
+                }
+                // The frame moves with the ground: every block feels −m ü0. The paper's
+                // large-mass ground is driven by f = m_g ü0 (eq. 4), which cancels it.
+                if b.role != BlockRole::LargeMassGround {
+                    let t_alpha = self.time + (1.0 - c.alpha_f) * dt;
+                    sys.r[s] -= b.total_mass() * self.ground_accel(t_alpha);
+                }
+            }
+        }
+        let centroids = self.centroids();
+        for e in elements {
+            sys.add_nodal_element(&self.dofs, known, &centroids, e);
+        }
+        for l in &self.loads {
+            if let Some(s) = self.dofs.slot[l.block] {
+                let f = t_transpose_times(centroids[l.block], l.point, l.force);
+                sys.add_rhs(s, &f, 1.0);
+            }
+        }
+    }
+
+    /// Adds the contact terms of the current trial states.
+    pub(super) fn add_contacts(&self, sys: &mut System, known: &[Vec6], mode: Mode) {
+        for c in &self.contacts {
+            if let Mode::Dynamic { dt } = mode {
+                self.add_dashpots(sys, c, dt);
+            }
+            let (i, j) = (c.key.vertex_block, c.key.edge_block);
+            // Augmented Lagrangian: the multipliers carry the force, the springs only
+            // pull the iterate onto the constraint (energy ½p g² − λ g).
+            let (lambda_n, lambda_s) = if self.augmented() {
+                (c.normal_multiplier, c.shear_multiplier)
+            } else {
+                (0.0, 0.0)
+            };
+            match c.state {
+                ContactState::Open => {}
+                ContactState::Locked => {
+                    let p = c.props.normal_penalty;
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        known,
+                        p,
+                        p * c.gap0 - lambda_n,
+                        (i, &c.gap_i),
+                        Some((j, &c.gap_j)),
+                    );
+                    let ps = c.props.shear_penalty;
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        known,
+                        ps,
+                        ps * c.shear0 - lambda_s,
+                        (i, &c.slip_i),
+                        Some((j, &c.slip_j)),
+                    );
+                }
+                ContactState::Sliding { direction } => {
+                    let p = c.props.normal_penalty;
+                    sys.add_scalar_spring(
+                        &self.dofs,
+                        known,
+                        p,
+                        p * c.gap0 - lambda_n,
+                        (i, &c.gap_i),
+                        Some((j, &c.gap_j)),
+                    );
+                    // Friction: −δρN along the slip direction on the vertex, +δρN on the edge;
+                    // as generalised forces that is −δρN·(slip_i, slip_j).
+                    let friction = match mode {
+                        Mode::Static { friction: Some(f) } => f,
+                        _ => c.props.friction,
+                    };
+                    let f = -direction * friction * c.friction_normal;
+                    if let Some(s) = self.dofs.slot[i] {
+                        sys.add_rhs(s, &c.slip_i, f);
+                    }
+                    if let Some(s) = self.dofs.slot[j] {
+                        sys.add_rhs(s, &c.slip_j, f);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Dashpot coefficients (normal, shear) of a contact in its trial state.
+    pub(super) fn dashpot_coefficients(&self, c: &Contact) -> (f64, f64) {
+        let zeta = self.params.contact_damping;
+        if zeta == 0.0 || !c.state.is_closed() {
+            return (0.0, 0.0);
+        }
+        let crit = |p: f64| 2.0 * zeta * (p * c.damping_mass).sqrt();
+        let shear = if c.state == ContactState::Locked {
+            crit(c.props.shear_penalty)
+        } else {
+            0.0
+        };
+        (crit(c.props.normal_penalty), shear)
+    }
+
+    /// Relative velocity along a contact direction: a·v_i + b·v_j.
+    pub(super) fn directional_velocity(
+        &self,
+        i: usize,
+        a: &Vec6,
+        j: usize,
+        b: &Vec6,
+        vel: &dyn Fn(usize) -> Vec6,
+    ) -> f64 {
+        dot6(a, &vel(i)) + dot6(b, &vel(j))
+    }
+
+    /// Adds the dashpots of a closed contact: force c·q̇ at the generalised-α point, with
+    /// q̇ of a free block from the Newmark velocity update (linear in the increment) and of
+    /// the prescribed ground from its motion.
+    pub(super) fn add_dashpots(&self, sys: &mut System, c: &Contact, dt: f64) {
+        let (cn, cs) = self.dashpot_coefficients(c);
+        let co = &self.coeffs;
+        let (i, j) = (c.key.vertex_block, c.key.edge_block);
+        for (damping, a, b) in [(cn, &c.gap_i, &c.gap_j), (cs, &c.slip_i, &c.slip_j)] {
+            if damping == 0.0 {
+                continue;
+            }
+            // v_{n+1} = γ/(βΔt)·D + w.
+            let mut f0 = 0.0;
+            let mut parts: Vec<(usize, &Vec6)> = Vec::with_capacity(2);
+            for (blk, vec) in [(i, a), (j, b)] {
+                let bl = &self.blocks[blk];
+                // The prescribed ground (no unknowns) stands still in the moving frame.
+                if self.dofs.slot[blk].is_some() {
+                    let mut w = [0.0; 6];
+                    for k in 0..6 {
+                        w[k] = co.velocity_predictor(bl.velocity[k], bl.accel[k], dt);
+                    }
+                    f0 += damping
+                        * ((1.0 - co.alpha_f) * dot6(vec, &w)
+                            + co.alpha_f * dot6(vec, &bl.velocity));
+                    parts.push((blk, vec));
+                }
+            }
+            let k = damping * co.gamma / (co.beta * dt);
+            match parts.as_slice() {
+                [] => {}
+                [p] => sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), None),
+                [p, q, ..] => {
+                    sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), Some((q.0, q.1)))
+                }
+            }
+        }
+    }
+}
