@@ -1,0 +1,48 @@
+//! Scenes shared by the integration tests (each test file that uses them declares
+//! `mod common;`).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use slidebase::model::Scene;
+
+/// A 1 m square box (ρ = 2000 kg/m³, E = 1 GPa) resting on a `theta_deg` incline 20 m
+/// long, 10 m up it, with Coulomb friction `friction` on the joint.
+pub fn incline_scene(theta_deg: f64, friction: f64) -> Scene {
+    let (s, c) = theta_deg.to_radians().sin_cos();
+    let l = 20.0;
+    let a = 1.0;
+    let x0 = 10.0;
+    let p0 = [x0 * c, x0 * s];
+    let v = [
+        p0,
+        [p0[0] + a * c, p0[1] + a * s],
+        [p0[0] + a * c - a * s, p0[1] + a * s + a * c],
+        [p0[0] - a * s, p0[1] + a * c],
+    ];
+    let fmt = |p: [f64; 2]| format!("[{:.15}, {:.15}]", p[0], p[1]);
+    let text = format!(
+        r#"
+name = "incline"
+[[block]]
+name = "ground"
+vertices = [[0.0, -1.0], [{lc}, -1.0], [{lc}, {ls}], [0.0, 0.0]]
+material = {{ density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }}
+[[block]]
+name = "box"
+vertices = [{v0}, {v1}, {v2}, {v3}]
+material = {{ density = 2000.0, youngs_modulus = 1.0e9, poisson_ratio = 0.2 }}
+[ground]
+block = "ground"
+[[contact]]
+blocks = ["box", "ground"]
+friction = {friction}
+"#,
+        lc = l * c,
+        ls = l * s,
+        v0 = fmt(v[0]),
+        v1 = fmt(v[1]),
+        v2 = fmt(v[2]),
+        v3 = fmt(v[3]),
+    );
+    Scene::from_toml(&text, "incline").unwrap()
+}
