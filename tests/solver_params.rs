@@ -429,7 +429,9 @@ fn contact_damping_is_the_damping_ratio_of_the_contact_springs() {
 
 /// The augmented Lagrangian iterates until every closed contact's violation times its
 /// penalty is below `constraint_tolerance` of the largest contact force. Checked on every
-/// accepted step of the incline for the default 1e-10 and a loose 1e-2: the penetration p·g
+/// accepted step of the incline for the default 1e-10, 1e-6 and a loose 1e-2 (at 1e-6 the
+/// event projection once waited for multipliers at round-off, 1e-8 N, gave up after 200
+/// updates and left the velocities unprojected: travel error 1e-3): the penetration p·g
 /// stays within the tolerance of the largest contact force; the loose tolerance takes
 /// fewer constraint solves; and the slide still follows ½ g (sin θ − μ cos θ) t² within the
 /// error the tolerance allows — friction off by at most tol of the two contacts' largest
@@ -438,7 +440,7 @@ fn contact_damping_is_the_damping_ratio_of_the_contact_springs() {
 #[test]
 fn constraint_tolerance_trades_iterations_for_constraint_accuracy() {
     let mut iterations = Vec::new();
-    for tolerance in [1e-10, 1e-2] {
+    for tolerance in [1e-10, 1e-6, 1e-2] {
         let params = SolverParams {
             constraint_tolerance: tolerance,
             ..SolverParams::default()
@@ -476,7 +478,7 @@ fn constraint_tolerance_trades_iterations_for_constraint_accuracy() {
         iterations.push(dda.counters().constraint_iterations);
     }
     assert!(
-        iterations[1] < iterations[0],
+        iterations.windows(2).all(|w| w[1] <= w[0]) && iterations[2] < iterations[0],
         "constraint solves: {iterations:?}"
     );
 }

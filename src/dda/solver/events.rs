@@ -194,6 +194,10 @@ impl Dda {
         }
         let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
         let key = 0x5eed_0000_0000_0001 ^ mass_factor.to_bits();
+        // The multipliers are momenta (or forces) like the field's own M x: when all of
+        // them are below 1e-10 of the largest of these (a block that only touches, 1e-8
+        // N), they are round-off, and their relative changes are not waited for.
+        let momentum = base.r.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
         for _ in 0..200 {
             let mut sys = base.clone();
             for (c, m) in self.contacts.iter().zip(&multipliers) {
@@ -246,7 +250,7 @@ impl Dda {
                     scale = scale.max(m[1].abs());
                 }
             }
-            if worst <= self.params.constraint_tolerance * scale || scale == 0.0 {
+            if worst <= self.params.constraint_tolerance * scale || scale <= 1e-10 * momentum {
                 for (bi, b) in self.blocks.iter_mut().enumerate() {
                     if self.dofs.slot[bi].is_some() {
                         *field.of_mut(b) = x[bi];
