@@ -482,3 +482,19 @@ fn constraint_tolerance_trades_iterations_for_constraint_accuracy() {
         "constraint solves: {iterations:?}"
     );
 }
+
+/// A tolerance the multipliers cannot reach, or one that would let contacts leak, is
+/// refused before the run, naming the field.
+#[test]
+fn constraint_tolerance_out_of_range_is_refused() {
+    for bad in [-1e-6, 0.0, 1e-16, 0.5, f64::NAN] {
+        let params = SolverParams {
+            constraint_tolerance: bad,
+            ..SolverParams::default()
+        };
+        let err = Dda::new(&incline_scene(), None, params)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("constraint_tolerance"), "{bad}: {err}");
+    }
+}

@@ -270,6 +270,14 @@ impl SolverParams {
         }
         crate::error::require_positive("max_displacement_ratio", self.max_displacement_ratio)?;
         crate::error::require_non_negative("contact_damping", self.contact_damping)?;
+        // Below ~100 ulps the multipliers cannot settle to it; above a tenth the contacts
+        // would leak a tenth of their force.
+        if !(self.constraint_tolerance >= 1e-14 && self.constraint_tolerance <= 0.1) {
+            return Err(Error::invalid(
+                "constraint_tolerance",
+                format!("must be in [1e-14, 0.1], got {}", self.constraint_tolerance),
+            ));
+        }
         Ok(())
     }
 }
