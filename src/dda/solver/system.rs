@@ -109,18 +109,21 @@ impl Dda {
             } else {
                 (0.0, 0.0)
             };
+            // Every closed contact resists approach; what acts along it depends on the state.
+            if c.state.is_closed() {
+                let p = c.props.normal_penalty;
+                sys.add_scalar_spring(
+                    &self.dofs,
+                    known,
+                    p,
+                    p * c.gap0 - lambda_n,
+                    (i, &c.gap_i),
+                    Some((j, &c.gap_j)),
+                );
+            }
             match c.state {
                 ContactState::Open => {}
                 ContactState::Locked => {
-                    let p = c.props.normal_penalty;
-                    sys.add_scalar_spring(
-                        &self.dofs,
-                        known,
-                        p,
-                        p * c.gap0 - lambda_n,
-                        (i, &c.gap_i),
-                        Some((j, &c.gap_j)),
-                    );
                     let ps = c.props.shear_penalty;
                     sys.add_scalar_spring(
                         &self.dofs,
@@ -132,15 +135,6 @@ impl Dda {
                     );
                 }
                 ContactState::Sliding { direction } => {
-                    let p = c.props.normal_penalty;
-                    sys.add_scalar_spring(
-                        &self.dofs,
-                        known,
-                        p,
-                        p * c.gap0 - lambda_n,
-                        (i, &c.gap_i),
-                        Some((j, &c.gap_j)),
-                    );
                     // Friction: −δρN along the slip direction on the vertex, +δρN on the edge;
                     // as generalised forces that is −δρN·(slip_i, slip_j).
                     let friction = match mode {
