@@ -289,8 +289,8 @@ impl Dda {
             // lowest extreme corners (free to move horizontally, no rotation or bounce).
             let g = &mut blocks[ground];
             let target = scene.ground.mass_ratio * structure_mass;
-            g.material.density = target / g.moments.area;
-            g.mass = super::block::mass_matrix(g.material.density, &g.moments);
+            g.material.density = target / g.rest_area;
+            g.mass = g.current_mass_matrix();
             let left = g
                 .vertices
                 .iter()
@@ -369,13 +369,11 @@ impl Dda {
             for k in 0..3 {
                 owners[k] = scene.block_index(&c.nodes[k].block)?;
             }
-            connections.push(Connection {
-                blocks: owners,
-                nodes: [c.nodes[0].point, c.nodes[1].point, c.nodes[2].point],
-                elasticity: c.material.elasticity(),
-                strain: [0.0; 3],
-                stress: [0.0; 3],
-            });
+            connections.push(Connection::new(
+                owners,
+                [c.nodes[0].point, c.nodes[1].point, c.nodes[2].point],
+                c.material.elasticity(),
+            ));
         }
         let mut loads = Vec::new();
         for l in &scene.point_loads {

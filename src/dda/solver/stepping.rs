@@ -460,7 +460,27 @@ impl Dda {
             let u = point_displacement(centroids[l.block], l.point, &increments[l.block]);
             external += l.force[0] * u[0] + l.force[1] * u[1];
         }
+        // The forces this step balanced at its end, to be compared with those of the
+        // geometry it moves to (see `rebalance_accelerations`).
+        let before = self.configuration_forces(Some(increments));
+        let old_inertia: PerBlock<Vec6> = self
+            .blocks
+            .iter()
+            .map(|b| {
+                let mut f = [0.0; 6];
+                for i in 0..6 {
+                    f[i] = (0..6).map(|j| b.mass[i][j] * b.response_accel[j]).sum();
+                }
+                f
+            })
+            .collect();
         self.commit_geometry(increments)?;
+        // The contacts' forces at the step's end (in the memory just written) along the
+        // step's gradients.
+        let mut before = before;
+        self.add_contact_forces(&mut before);
+        let after = self.configuration_forces(None);
+        self.rebalance_accelerations(&old_inertia, &before, &after);
         self.time = t_new;
 
         let e = &mut self.energy;
@@ -514,5 +534,137 @@ impl Dda {
             self.counters.max_energy_residual_rel.max(residual_rel);
         self.last = report;
         Ok(report)
+    }
+}
+
+impl Dda {
+    /// The generalised forces that the configuration exerts on each block: the block
+    /// stresses, the joints and the point loads (not gravity or the ground's body force,
+    /// which do not depend on it). With `increments`, their linearised values at the end
+    /// of the step the increments were solved with (the forces that step balanced; the
+    /// contacts' are added by the caller once their memory holds the end values);
+    /// without, their values at the current geometry, contacts included (the forces the
+    /// next step starts from).
+    pub(super) fn configuration_forces(&mut self, increments: Option<&[Vec6]>) -> PerBlock<Vec6> {
+        let mut out: PerBlock<Vec6> = PerBlock::from_elem([0.0; 6], self.blocks.len());
+        let centroids = self.centroids();
+        let zero = [0.0; 6];
+        let inc = |b: usize| increments.map_or(&zero, |d| &d[b]);
+        for (bi, (b, f)) in self.blocks.iter().zip(out.iter_mut()).enumerate() {
+            let d = inc(bi);
+            for i in 0..3 {
+                let stress =
+                    b.stress[i] + (0..3).map(|j| b.elasticity[i][j] * d[3 + j]).sum::<f64>();
+                f[3 + i] -= b.moments.area * stress;
+            }
+        }
+        // The step's own terms (kept from its assembly) for its end forces; fresh ones
+        // at the current geometry.
+        let elements = if increments.is_some() {
+            std::mem::take(&mut self.elements)
+        } else {
+            self.element_terms()
+        };
+        for e in &elements {
+            let nodes = e.nodes();
+            let u: SmallVec<[Point; 3]> = nodes
+                .iter()
+                .map(|&(b, x)| point_displacement(centroids[b], x, inc(b)))
+                .collect();
+            let forces = e.end_forces(&u);
+            for (k, &(b, x)) in nodes.iter().enumerate() {
+                let g = t_transpose_times(centroids[b], x, [forces[2 * k], forces[2 * k + 1]]);
+                for i in 0..6 {
+                    out[b][i] -= g[i];
+                }
+            }
+        }
+        if increments.is_some() {
+            self.elements = elements;
+        }
+        for l in &self.loads {
+            let g = t_transpose_times(centroids[l.block], l.point, l.force);
+            for i in 0..6 {
+                out[l.block][i] += g[i];
+            }
+        }
+        if increments.is_none() {
+            // The contacts' forces act along directions that turn with the blocks: at the
+            // current geometry the contacts are found again (the step's own, which the
+            // caller still reads, are kept).
+            let step_contacts = self.contacts.clone();
+            self.detect_contacts();
+            self.add_contact_forces(&mut out);
+            self.contacts = step_contacts;
+        }
+        out
+    }
+
+    /// Adds the generalised forces the closed contacts exert on the blocks: the normal
+    /// and shear forces of their memory along the gradients of `self.contacts`.
+    fn add_contact_forces(&self, out: &mut [Vec6]) {
+        for c in &self.contacts {
+            let Some(m) = self.memory.get(&c.key) else {
+                continue;
+            };
+            if !m.state.is_closed() {
+                continue;
+            }
+            let normal = m.normal_force;
+            let shear = m.shear_multiplier - c.props.shear_penalty * m.shear;
+            for (b, gap, slip) in [
+                (c.key.vertex_block, &c.gap_i, &c.slip_i),
+                (c.key.edge_block, &c.gap_j, &c.slip_j),
+            ] {
+                for k in 0..6 {
+                    out[b][k] += normal * gap[k] + shear * slip[k];
+                }
+            }
+        }
+    }
+
+    /// Makes the integrator's accelerations balance the forces of the geometry a step has
+    /// just moved to. A step balances the forces linearised about its start (`before`,
+    /// from [`Dda::configuration_forces`] with its increments); at the moved geometry the
+    /// same stresses give slightly different forces (`after`: the joints have turned, the
+    /// blocks' areas changed). Carrying the old accelerations into the next step would
+    /// apply that difference as an unbooked impulse: it did work of O(Δt) per unit time
+    /// against a gravity preload (the three-storey frame gained energy from gravity and
+    /// crept from its settled state). The accelerations take up the difference instead,
+    /// so each step's trapezoidal work is exactly the change of the stored energy.
+    pub(super) fn rebalance_accelerations(
+        &mut self,
+        old_inertia: &[Vec6],
+        before: &[Vec6],
+        after: &[Vec6],
+    ) {
+        for (((b, inertia), f0), f1) in self
+            .blocks
+            .iter_mut()
+            .zip(old_inertia)
+            .zip(before)
+            .zip(after)
+        {
+            if b.role == BlockRole::PrescribedGround {
+                continue;
+            }
+            // A rigid block's strain accelerations stay zero: its strain rows are held.
+            let n = if b.rigid { 3 } else { 6 };
+            let mut m = nalgebra::Matrix6::<f64>::identity();
+            let mut r = nalgebra::Vector6::<f64>::zeros();
+            for i in 0..n {
+                r[i] = inertia[i] + f1[i] - f0[i];
+                for j in 0..n {
+                    m[(i, j)] = b.mass[i][j];
+                }
+            }
+            let Some(chol) = m.cholesky() else { continue };
+            let x = chol.solve(&r);
+            for i in 0..n {
+                let shift = x[i] - b.response_accel[i];
+                b.accel[i] += shift;
+                b.response_accel[i] = x[i];
+            }
+        }
     }
 }
