@@ -350,7 +350,14 @@ impl Block {
             }
         }
         self.rotation += d[2];
-        self.velocity = transport_velocity(&self.velocity, d, rotation);
+        // (The linear map of the rotation is kept as the paper's: it inflates a turning
+        // block, and its spin is left as it was rather than carried.)
+        if exact_rotation {
+            self.velocity = transport_velocity(&self.velocity, d, rotation);
+            if self.rigid {
+                self.velocity[3..].fill(0.0);
+            }
+        }
         update_edge_frames(&self.vertices, &mut self.edges);
         self.moments = geometry::moments(&self.vertices, &self.name)?;
         self.mass = self.current_mass_matrix();
