@@ -127,11 +127,11 @@ impl RunSpec {
             Some(a) => a,
             None => scene_alpha(&scene, &roles)?,
         };
-        let scene_law = self.joint_law(&scene, &roles.joint)?;
+        let law = self.joint_law(&scene, &roles.joint)?;
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            self.friction.unwrap_or(scene_law.sticking())
+            law.sticking()
         };
         let structure_hz = roles.structure_frequency_hz;
         // The scene's own harmonic input, as (amplitude, Ω/ω).
@@ -186,9 +186,9 @@ impl RunSpec {
         };
         params.validate()?;
         apply_two_block(&mut scene, &params)?;
-        if !self.fixed_base && self.friction.is_none() {
-            // The two-mass parameters set a Coulomb coefficient; a scene's own law stays.
-            set_joint_law(&mut scene, &roles.joint, scene_law);
+        if !self.fixed_base {
+            // The two-mass parameters set a Coulomb coefficient; the run's law is the one.
+            set_joint_law(&mut scene, &roles.joint, law);
         }
         let (motion, freq_ratio, excitation_label) = match record {
             None => (
@@ -254,8 +254,8 @@ impl RunSpec {
 
     /// A building: friction, fixed base and excitation set on the scene as it is.
     fn building(&self, mut scene: Scene, roles: StructureRoles) -> Result<RunSetup> {
-        if let Some(f) = self.friction {
-            set_joint_law(&mut scene, &roles.joint, Friction::Coulomb(f));
+        if let Some(law) = self.law_given() {
+            set_joint_law(&mut scene, &roles.joint, law);
         }
         let motion = match (&self.excitation, &scene.excitation) {
             (ExcitationSpec::Record { source, scale }, _)
@@ -336,13 +336,19 @@ impl RunSpec {
         ))
     }
 
+    /// The sliding joint's law as the run specification gives it (`--friction ρ` is
+    /// Coulomb's), if it does.
+    fn law_given(&self) -> Option<Friction> {
+        self.friction.map(Friction::Coulomb).or(self.friction_law)
+    }
+
     /// The friction law of the named joint as the run will have it (`--friction` replaces
     /// the scene's law by Coulomb's), refused for the exact mass-spring model unless it is
     /// Coulomb's: that model has no other law, and running it with the sticking
     /// coefficient alone would compare different physics without a word.
     fn joint_law(&self, scene: &Scene, joint: &str) -> Result<Friction> {
-        let law = match self.friction {
-            Some(f) => Friction::Coulomb(f),
+        let law = match self.law_given() {
+            Some(law) => law,
             // The scene's validation makes sure the joint exists.
             None => scene
                 .contacts

@@ -127,15 +127,23 @@ impl Dda {
                         alpha_f * c.start_slip_velocity + (1.0 - alpha_f) * slip_velocity,
                     ),
                 };
-                if let ContactState::Sliding { .. } = new_state
-                    && ((n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha)
-                        || (mu_alpha - c.sliding_coefficient).abs()
-                            > 1e-4 * mu_alpha.max(c.sliding_coefficient))
+                let sliding = matches!(new_state, ContactState::Sliding { .. });
+                let mu_moved = (mu_alpha - c.sliding_coefficient).abs()
+                    > 1e-4 * mu_alpha.max(c.sliding_coefficient);
+                if sliding
+                    && (mu_moved
+                        || (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha))
                 {
                     changed = true;
                 }
                 c.friction_normal = n_alpha;
-                c.sliding_coefficient = mu_alpha;
+                // A coefficient within the tolerance is left as the solve used it, so that
+                // the friction work booked and the force carried into the next step are
+                // the ones the step was solved with (the energy balance of a velocity law
+                // closed to 1e-6 only when the settled pass's re-evaluation was booked).
+                if mu_moved || !sliding {
+                    c.sliding_coefficient = mu_alpha;
+                }
                 // A contact that keeps flipping within one step (stuck ↔ sliding with the
                 // penalty spring's unresolved dynamics on either side of the limit) keeps
                 // its latest state: the step is then decided, at a small cost in accuracy,

@@ -81,7 +81,12 @@ impl Dda {
                     ContactState::Open => (0.0, 0.0, 0.0),
                     ContactState::Locked => (stuck_stretch, normal, c.shear_multiplier),
                     ContactState::Sliding { direction } => {
-                        let mu = c.props.friction.sliding_coefficient(c.end_slip_velocity);
+                        // The coefficient the step was solved with (the law at the α point, as
+                        // iterated), so the next step starts from the force this one used.
+                        // The coefficient the step was solved with (the law at the α point as
+                        // iterated; a settle's override), so the next step starts from the
+                        // force this one used.
+                        let mu = c.sliding_coefficient;
                         (0.0, normal, -direction * mu * normal.max(0.0))
                     }
                 }
