@@ -18,10 +18,6 @@ impl Dda {
                 if m.state.is_closed() {
                     m.state = ContactState::Locked;
                     m.shear = 0.0;
-                    // No shear force either (the memory used to carry ρN here, the sliding
-                    // force at the joint's own ρ although the settle had let it slip freely).
-                    m.shear_multiplier = 0.0;
-                    m.shear_change = 0.0;
                 }
             }
             return Ok(());

@@ -81,12 +81,15 @@ impl Dda {
                     ContactState::Open => (0.0, 0.0, 0.0),
                     ContactState::Locked => (stuck_stretch, normal, c.shear_multiplier),
                     ContactState::Sliding { direction } => {
-                        // The coefficient the step was solved with (the law at the α point, as
-                        // iterated), so the next step starts from the force this one used.
-                        // The coefficient the step was solved with (the law at the α point as
-                        // iterated; a settle's override), so the next step starts from the
-                        // force this one used.
-                        let mu = c.sliding_coefficient;
+                        // A speed-dependent law: the coefficient the step was solved with (at
+                        // the α point, as iterated), so that the next step starts from the
+                        // force this one used and booked. (A constant law's own value also
+                        // after a settle that overrode it: see NOTES-issue-13.)
+                        let mu = if c.props.friction.depends_on_speed() {
+                            c.sliding_coefficient
+                        } else {
+                            c.props.friction.sliding_coefficient(c.end_slip_velocity)
+                        };
                         (0.0, normal, -direction * mu * normal.max(0.0))
                     }
                 }
