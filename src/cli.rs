@@ -10,6 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use slidebase::dda::Integrator;
 use slidebase::headless::run::{OUTPUT_HISTORY, run_setup, write_outputs};
 use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, parse_shard, run_sweep};
+use slidebase::model::friction::Friction;
 use slidebase::model::scene::GroundKind;
 use slidebase::post::output::Staged;
 use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
@@ -85,6 +86,11 @@ struct RunArgs {
     /// Friction coefficient ρ of the sliding joint, in [0, 1000] (default: the scene's).
     #[arg(long, allow_hyphen_values = true)]
     friction: Option<f64>,
+    /// Friction law of the sliding joint: coulomb:MU | static-kinetic:MU_S,MU_K |
+    /// velocity:MU_SLOW,MU_FAST,RATE (μ(v) = MU_FAST − (MU_FAST − MU_SLOW)·exp(−RATE·|v|),
+    /// v in m/s, RATE in s/m); DDA only (default: the scene's). See docs/friction-laws.md.
+    #[arg(long = "friction-law", conflicts_with = "friction")]
+    friction_law: Option<Friction>,
     /// Excitation frequency over the structure frequency, Ω/ω (two-block scenes; default:
     /// the scene's, 1).
     #[arg(
@@ -106,7 +112,7 @@ struct RunArgs {
     #[arg(long, value_enum, default_value = "dda")]
     model: ModelArg,
     /// Fix the base: the sliding joint never slides.
-    #[arg(long, conflicts_with = "friction")]
+    #[arg(long, conflicts_with_all = ["friction", "friction_law"])]
     fixed_base: bool,
     /// Ground-motion record (built-in name or AT2/CSV file) instead of harmonic input.
     #[arg(long)]
@@ -376,6 +382,7 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
         excitation,
         alpha: args.alpha,
         friction: args.friction,
+        friction_law: args.friction_law,
         fixed_base: args.fixed_base,
         pga_g: None,
         ground: args.ground.map(|g| match g {

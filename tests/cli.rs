@@ -12,6 +12,16 @@ fn slidebase(args: &[&str]) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// The one JSON object a successful `--json` run prints.
+fn json_of(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
 #[test]
 fn run_json_has_the_documented_keys() {
     let out = slidebase(&[
@@ -26,13 +36,7 @@ fn run_json_has_the_documented_keys() {
         "5",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value =
-        serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    let v = json_of(&out);
     for key in [
         "us_max_over_d",
         "ur_max_over_d",
@@ -301,4 +305,59 @@ fn sweep_shards_merge_into_the_whole_grid() {
         err.contains("more than one input") && err.lines().count() == 1,
         "{err}"
     );
+}
+
+/// `--friction-law` runs a law other than Coulomb's on the sliding joint, and is refused
+/// by name where it cannot be: a law that cannot be, together with `--friction`, and with
+/// the exact model (Coulomb only).
+#[test]
+fn friction_law_runs_or_is_refused_by_name() {
+    let out = slidebase(&[
+        "run",
+        "--friction-law",
+        "static-kinetic:0.15,0.1",
+        "--duration",
+        "5",
+        "--json",
+    ]);
+    let json = json_of(&out);
+    assert!(json["us_max_m"].as_f64().unwrap() > 0.0);
+    for (args, says) in [
+        (
+            vec!["--friction-law", "static-kinetic:0.1,0.15"],
+            "must not exceed",
+        ),
+        (
+            vec!["--friction-law", "stribeck:1"],
+            "velocity:MU_SLOW,MU_FAST,RATE",
+        ),
+        (
+            vec![
+                "--friction-law",
+                "velocity:0.05,0.1,20",
+                "--friction",
+                "0.1",
+            ],
+            "cannot be used with",
+        ),
+        (
+            vec![
+                "--friction-law",
+                "velocity:0.05,0.1,20",
+                "--model",
+                "mass-spring",
+            ],
+            "Coulomb friction only",
+        ),
+    ] {
+        let out = slidebase(&[&["run"], args.as_slice()].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+        assert!(
+            err.contains("--friction-law") || err.contains("--model"),
+            "{args:?}: {err}"
+        );
+        assert!(err.contains(says), "{args:?}: '{err}' lacks '{says}'");
+    }
 }

@@ -691,3 +691,71 @@ fn a_scene_joint_of_infinite_friction_runs_without_null() {
             .any(|w| w.contains("never slides"))
     );
 }
+
+/// A joint's friction law is written as a number (Coulomb) or as a named law; a law that
+/// cannot be is refused with its line and the forms that would be accepted.
+#[test]
+fn friction_laws_in_a_scene_file_are_parsed_or_refused_with_their_line() {
+    use slidebase::model::friction::Friction;
+    let with = |law: &str| TWO_BLOCK.replace("friction = 0.1", &format!("friction = {law}"));
+    let scene = Scene::from_toml(&with("\"static-kinetic:0.6,0.4\""), "s.toml").unwrap();
+    assert_eq!(
+        scene.contacts[0].friction,
+        Friction::StaticKinetic {
+            stick: 0.6,
+            slide: 0.4
+        }
+    );
+    let scene = Scene::from_toml(&with("\"velocity:0.05,0.1,20\""), "s.toml").unwrap();
+    assert!(matches!(
+        scene.contacts[0].friction,
+        Friction::Velocity { .. }
+    ));
+    assert_has(
+        &scene_error(&with("\"static-kinetic:0.4,0.6\"")),
+        &["s.toml:49", "must not exceed"],
+    );
+    assert_has(
+        &scene_error(&with("\"stribeck:0.1\"")),
+        &[
+            "s.toml:49",
+            "static-kinetic:MU_S,MU_K",
+            "velocity:MU_SLOW,MU_FAST,RATE",
+        ],
+    );
+    assert_has(&scene_error(&with("-0.5")), &["friction", "got -0.5"]);
+}
+
+/// A two-block scene whose joint has a static-kinetic law keeps it in a DDA run (the
+/// two-mass parameters set only a Coulomb coefficient, which must not replace it), and
+/// the exact model, which has Coulomb friction only, refuses it by its flag.
+#[test]
+fn a_scene_friction_law_is_kept_by_dda_and_refused_by_the_exact_model() {
+    use slidebase::model::friction::Friction;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sk.toml");
+    let law = "static-kinetic:0.15,0.1";
+    std::fs::write(
+        &path,
+        TWO_BLOCK.replace("friction = 0.1", &format!("friction = \"{law}\"")),
+    )
+    .unwrap();
+    let spec = |model| RunSpec {
+        model,
+        duration: Some(1.0),
+        ..RunSpec::scene(path.to_str().unwrap())
+    };
+    let setup = spec(ModelKind::Dda).prepare().unwrap();
+    let joint = setup.scene.contacts.iter().find(|c| c.name == setup.joint);
+    assert_eq!(joint.unwrap().friction, law.parse::<Friction>().unwrap());
+    assert_has(
+        &spec_error(spec(ModelKind::MassSpring)),
+        &["--model mass-spring", "Coulomb friction only", law],
+    );
+    // --friction states a Coulomb coefficient, which the exact model takes.
+    let coulomb = RunSpec {
+        friction: Some(0.1),
+        ..spec(ModelKind::MassSpring)
+    };
+    assert!(coulomb.prepare().is_ok());
+}

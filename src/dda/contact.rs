@@ -13,7 +13,9 @@
 use rustc_hash::FxHashMap;
 
 use super::block::{Block, EdgeFrame, Vec6, t_transpose_times};
+use super::friction::FrictionLaw;
 use super::judge::ContactState;
+use crate::model::friction::Friction;
 use crate::model::geometry::{Point, contains, cross, dot, sub};
 
 /// What the contacts of the last step remember, by key.
@@ -35,8 +37,8 @@ pub struct ContactKey {
 /// Joint properties of a declared contact pair, resolved to numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointProps {
-    /// Coulomb coefficient ρ (may be +∞).
-    pub friction: f64,
+    /// The friction law (asked through [`super::FrictionLaw`]).
+    pub friction: Friction,
     /// Normal penalty, N/m.
     pub normal_penalty: f64,
     /// Shear penalty, N/m.
@@ -109,6 +111,9 @@ pub struct Contact {
     pub flips: u32,
     /// Normal force used for friction in the current pass, N.
     pub friction_normal: f64,
+    /// Sliding friction coefficient used in the current pass (the law's, at the slip speed
+    /// of the previous pass's α point).
+    pub sliding_coefficient: f64,
     /// Normal force at the step start (from the contact memory), N.
     pub start_normal: f64,
     /// Change of the normal force over the previous step, N (0 for a new contact).
@@ -414,6 +419,7 @@ fn linearise(
         shear0,
         state: start_state,
         friction_normal: normal,
+        sliding_coefficient: props.friction.sliding_coefficient(start_slip_velocity),
         start_normal: normal,
         previous_normal_change: normal_change,
         damping_mass: {
@@ -460,7 +466,7 @@ mod tests {
         let i = block(vec![[0.0, 0.1], [1.0, 0.1], [1.0, 1.0], [0.0, 1.0]]);
         let j = block(vec![[-2.0, -1.0], [3.0, -1.2], [3.0, 0.0], [-2.0, 0.05]]);
         let props = JointProps {
-            friction: 0.3,
+            friction: Friction::Coulomb(0.3),
             normal_penalty: 1.0,
             shear_penalty: 1.0,
             bonded: false,

@@ -11,6 +11,7 @@ pub mod assembly;
 pub mod block;
 pub mod contact;
 pub mod energy;
+pub mod friction;
 pub mod integrator;
 pub mod joints;
 pub mod judge;
@@ -19,5 +20,6 @@ pub mod params;
 pub mod solver;
 
 pub use energy::EnergyTerms;
+pub use friction::FrictionLaw;
 pub use params::{ContactEnforcement, Integrator, SolverParams};
 pub use solver::{Dda, Modes, RunCounters, StepReport};

@@ -326,7 +326,7 @@ pub fn equivalent_mdof_with(
         .contacts
         .iter()
         .find(|c| c.name == r.joint)
-        .map_or(0.0, |c| c.friction);
+        .map_or(0.0, |c| c.friction.sticking());
     let storey_masses = masses[1..].to_vec();
     let (stiffnesses, fit_error) = fit_storey_stiffnesses(&storey_masses, &report.frequencies_hz)?;
     let report = ModesReport {

@@ -8,6 +8,7 @@
 //!
 //! Both are ordinary [`Scene`]s: they can be run, rendered or written out as TOML.
 
+use super::friction::Friction;
 use super::material::Material;
 use super::scene::{
     BlockDef, ConnectionDef, ConnectionNode, ContactDef, ExcitationDef, GroundDef, GroundKind,
@@ -172,7 +173,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
         vec![ContactDef {
             name: "sliding-joint".into(),
             blocks: ["base-slab".into(), "ground".into()],
-            friction: 0.01,
+            friction: Friction::Coulomb(0.01),
             normal_penalty: Some(2.0e12),
             shear_penalty: Some(2.0e12),
             bonded: false,
@@ -255,7 +256,7 @@ pub fn wall(n: usize) -> Result<Scene> {
     let joint = |a: &str, b: &str| ContactDef {
         name: String::new(),
         blocks: [a.into(), b.into()],
-        friction: 0.7,
+        friction: Friction::Coulomb(0.7),
         normal_penalty: None,
         shear_penalty: None,
         bonded: false,
@@ -268,7 +269,7 @@ pub fn wall(n: usize) -> Result<Scene> {
     let mut contacts = vec![ContactDef {
         name: "sliding-joint".into(),
         blocks: ["base-slab".into(), "ground".into()],
-        friction: 0.1,
+        friction: Friction::Coulomb(0.1),
         normal_penalty: None,
         shear_penalty: None,
         bonded: false,

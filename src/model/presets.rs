@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use super::friction::Friction;
 use super::scene::{ExcitationDef, Scene};
 use crate::{Error, Result};
 
@@ -102,7 +103,7 @@ pub fn apply_two_block(scene: &mut Scene, p: &TwoBlockParams) -> Result<()> {
         b.stiffness = m * omega * omega;
     }
     for c in scene.contacts.iter_mut().filter(|c| c.name == roles.joint) {
-        c.friction = p.friction;
+        c.friction = Friction::Coulomb(p.friction);
     }
     scene.excitation = ExcitationDef::Harmonic {
         amplitude_g: p.amplitude_g,

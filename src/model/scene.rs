@@ -9,6 +9,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::friction::Friction;
 use super::geometry::Point;
 use super::material::Material;
 use crate::ground_motion::STANDARD_GRAVITY;
@@ -134,8 +135,10 @@ pub struct ContactDef {
     pub name: String,
     /// The two block names.
     pub blocks: [String; 2],
-    /// Coulomb friction coefficient ρ (static = kinetic, as in the paper); `inf` never slides.
-    pub friction: f64,
+    /// The friction law: a number is Coulomb's coefficient ρ (static = kinetic, as in the
+    /// paper; `inf` never slides); a string names another law
+    /// (`"static-kinetic:0.6,0.4"`, `"velocity:0.05,0.1,20"`, see [`Friction`]).
+    pub friction: Friction,
     /// Normal penalty spring, N/m per unit thickness. Default: 100 × the larger E of the
     /// two blocks (the paper's choice).
     #[serde(default)]

@@ -11,8 +11,8 @@ use super::geometry::{self, Point};
 use super::scene::{ExcitationDef, GroundKind, Scene};
 use crate::limits::{
     FREQUENCY_RANGE_HZ, MAX_ACCEL_G, MAX_BLOCKS, MAX_COORDINATE_M, MAX_ELEMENTS, MAX_FORCE_N,
-    MAX_FRICTION, MAX_GRAVITY, MAX_POLYGON_VERTICES, MAX_SCENE_VERTICES, MAX_SPAN_RATIO,
-    MIN_AMPLITUDE_G, STIFFNESS_RANGE,
+    MAX_GRAVITY, MAX_POLYGON_VERTICES, MAX_SCENE_VERTICES, MAX_SPAN_RATIO, MIN_AMPLITUDE_G,
+    STIFFNESS_RANGE,
 };
 use crate::{Error, Result};
 
@@ -396,15 +396,11 @@ fn check_contacts(scene: &Scene, names: &HashMap<&str, usize>) -> Check {
                 ),
             ));
         }
-        let f = c.friction;
-        if !(f == f64::INFINITY || (f.is_finite() && (0.0..=MAX_FRICTION).contains(&f))) {
+        if let Err(problem) = c.friction.check() {
             return Err(Issue::new(
                 at("friction"),
                 format!("{label} friction"),
-                format!(
-                    "must be in [0, {MAX_FRICTION}] or inf (never slides), got {}",
-                    crate::error::show(f)
-                ),
+                problem,
             ));
         }
         for (key, v) in [

@@ -32,6 +32,23 @@ pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
             ),
         ));
     }
+    if spec.friction.is_some() && spec.friction_law.is_some() {
+        return Err(Error::invalid(
+            "--friction-law",
+            "conflicts with --friction: give the joint one law (--friction ρ is \
+             --friction-law coulomb:ρ)",
+        ));
+    }
+    if spec.fixed_base && spec.friction_law.is_some() {
+        return Err(Error::invalid(
+            "--friction-law",
+            "conflicts with --fixed-base: a fixed base never slides, whatever its law",
+        ));
+    }
+    if let Some(law) = spec.friction_law {
+        law.check()
+            .map_err(|e| Error::invalid("--friction-law", e))?;
+    }
     if let Some(f) = spec.friction {
         if f == f64::INFINITY {
             return Err(Error::invalid(

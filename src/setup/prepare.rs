@@ -9,6 +9,7 @@ use super::{check, defaults};
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
+use crate::model::friction::Friction;
 use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground};
 use crate::model::scene::{ExcitationDef, StructureRoles, TwoBlockRoles};
 use crate::{Error, Result};
@@ -126,11 +127,11 @@ impl RunSpec {
             Some(a) => a,
             None => scene_alpha(&scene, &roles)?,
         };
-        let joint_friction = joint_friction(&scene, &roles.joint);
+        let law = self.joint_law(&scene, &roles.joint)?;
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            self.friction.unwrap_or(joint_friction)
+            law.sticking()
         };
         let structure_hz = roles.structure_frequency_hz;
         // The scene's own harmonic input, as (amplitude, Ω/ω).
@@ -185,6 +186,10 @@ impl RunSpec {
         };
         params.validate()?;
         apply_two_block(&mut scene, &params)?;
+        if !self.fixed_base {
+            // The two-mass parameters set a Coulomb coefficient; the run's law is the one.
+            set_joint_law(&mut scene, &roles.joint, law);
+        }
         let (motion, freq_ratio, excitation_label) = match record {
             None => (
                 GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude_g, ratio * structure_hz)?),
@@ -249,10 +254,8 @@ impl RunSpec {
 
     /// A building: friction, fixed base and excitation set on the scene as it is.
     fn building(&self, mut scene: Scene, roles: StructureRoles) -> Result<RunSetup> {
-        if let Some(f) = self.friction {
-            for c in scene.contacts.iter_mut().filter(|c| c.name == roles.joint) {
-                c.friction = f;
-            }
+        if let Some(law) = self.law_given() {
+            set_joint_law(&mut scene, &roles.joint, law);
         }
         let motion = match (&self.excitation, &scene.excitation) {
             (ExcitationSpec::Record { source, scale }, _)
@@ -318,7 +321,7 @@ impl RunSpec {
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            joint_friction(&scene, &roles.joint)
+            self.joint_law(&scene, &roles.joint)?.sticking()
         };
         let roof = roles.floors.last().unwrap_or(&roles.base).clone();
         let blocks = [roles.base.clone(), roof, roles.joint.clone()];
@@ -331,6 +334,42 @@ impl RunSpec {
             friction,
             label,
         ))
+    }
+
+    /// The sliding joint's law as the run specification gives it (`--friction ρ` is
+    /// Coulomb's), if it does.
+    fn law_given(&self) -> Option<Friction> {
+        self.friction.map(Friction::Coulomb).or(self.friction_law)
+    }
+
+    /// The friction law of the named joint as the run will have it (`--friction` replaces
+    /// the scene's law by Coulomb's), refused for the exact mass-spring model unless it is
+    /// Coulomb's: that model has no other law, and running it with the sticking
+    /// coefficient alone would compare different physics without a word.
+    fn joint_law(&self, scene: &Scene, joint: &str) -> Result<Friction> {
+        let law = match self.law_given() {
+            Some(law) => law,
+            // The scene's validation makes sure the joint exists.
+            None => scene
+                .contacts
+                .iter()
+                .find(|c| c.name == joint)
+                .map_or(Friction::Coulomb(0.0), |c| c.friction),
+        };
+        if self.model == ModelKind::MassSpring
+            && !self.fixed_base
+            && !matches!(law, Friction::Coulomb(_))
+        {
+            return Err(Error::invalid(
+                "--model mass-spring",
+                format!(
+                    "the exact mass-spring model has Coulomb friction only, and the joint \
+                     '{joint}' has '{law}'; use --model dda, or --friction to set a Coulomb \
+                     coefficient"
+                ),
+            ));
+        }
+        Ok(law)
     }
 }
 
@@ -376,9 +415,7 @@ impl RunSetup {
             "",
         )?;
         let mut scene = self.scene.clone();
-        for c in scene.contacts.iter_mut().filter(|c| c.name == self.joint) {
-            c.friction = friction;
-        }
+        set_joint_law(&mut scene, &self.joint, Friction::Coulomb(friction));
         Ok(scene)
     }
 
@@ -405,14 +442,11 @@ fn scene_alpha(scene: &Scene, roles: &TwoBlockRoles) -> Result<f64> {
     Ok(m / (m + big_m))
 }
 
-/// The friction coefficient of the named joint (0 if the scene has none of that name; the
-/// scene's validation makes sure it has).
-fn joint_friction(scene: &Scene, joint: &str) -> f64 {
-    scene
-        .contacts
-        .iter()
-        .find(|c| c.name == joint)
-        .map_or(0.0, |c| c.friction)
+/// Gives the named joint the friction law `law`.
+fn set_joint_law(scene: &mut Scene, joint: &str, law: Friction) {
+    for c in scene.contacts.iter_mut().filter(|c| c.name == joint) {
+        c.friction = law;
+    }
 }
 
 /// A record by name or file, scaled.

@@ -6,6 +6,7 @@ use serde::Serialize;
 use crate::Result;
 use crate::dda::Integrator;
 use crate::model::Scene;
+use crate::model::friction::Friction;
 use crate::model::presets::resolve_scene;
 use crate::model::scene::GroundKind;
 
@@ -156,6 +157,8 @@ pub struct RunSpec {
     pub alpha: Option<f64>,
     /// Friction coefficient ρ of the sliding joint (default: the scene's).
     pub friction: Option<f64>,
+    /// Friction law of the sliding joint (default: the scene's; not with `friction`).
+    pub friction_law: Option<Friction>,
     /// Fix the base: the sliding joint is bonded and never slides.
     pub fixed_base: bool,
     /// Scale the ground motion to this peak ground acceleration over the run, g (default:

@@ -8,6 +8,17 @@ use slidebase::model::Scene;
 /// A 1 m square box (ρ = 2000 kg/m³, E = 1 GPa) resting on a `theta_deg` incline 20 m
 /// long, 10 m up it, with Coulomb friction `friction` on the joint.
 pub fn incline_scene(theta_deg: f64, friction: f64) -> Scene {
+    incline_scene_with_law(theta_deg, &friction.to_string())
+}
+
+/// The same incline with the joint's friction law written as in a scene file (a number,
+/// or e.g. `static-kinetic:0.6,0.4`).
+pub fn incline_scene_with_law(theta_deg: f64, law: &str) -> Scene {
+    let friction = if law.parse::<f64>().is_ok() {
+        law.to_string()
+    } else {
+        format!("\"{law}\"")
+    };
     let (s, c) = theta_deg.to_radians().sin_cos();
     let l = 20.0;
     let a = 1.0;

@@ -67,7 +67,8 @@ impl Dda {
             let mut friction_change = vec![0.0; self.dofs.n];
             for (c, &old) in self.contacts.iter().zip(&forces_before) {
                 if let ContactState::Sliding { direction } = c.start_state {
-                    let change = -direction * c.props.friction.min(1e30) * c.start_normal - old;
+                    let mu = c.props.friction.sliding_coefficient(c.start_slip_velocity);
+                    let change = -direction * mu * c.start_normal - old;
                     spread_force(
                         &self.dofs,
                         &mut friction_change,
@@ -103,7 +104,7 @@ impl Dda {
                 let new_state = if normal < 0.0 {
                     ContactState::Open
                 } else if c.start_state == ContactState::Locked
-                    && shear.abs() > c.props.friction * normal * (1.0 + 1e-9)
+                    && shear.abs() > c.props.friction.sticking_coefficient() * normal * (1.0 + 1e-9)
                 {
                     // The stick force on the vertex is −(pull): it slides the way pulled.
                     ContactState::Sliding {
@@ -120,7 +121,9 @@ impl Dda {
                 let shear_force = match new_state {
                     ContactState::Locked => shear,
                     ContactState::Sliding { direction } => {
-                        -direction * c.props.friction.min(1e30) * normal
+                        -direction
+                            * c.props.friction.sliding_coefficient(c.start_slip_velocity)
+                            * normal
                     }
                     ContactState::Open => 0.0,
                 };

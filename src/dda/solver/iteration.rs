@@ -101,7 +101,7 @@ impl Dda {
                     friction: match mode {
                         Mode::Static { friction: Some(f) } => f,
                         Mode::Modal => f64::INFINITY,
-                        _ => c.props.friction,
+                        _ => c.props.friction.sticking_coefficient(),
                     },
                     slip_increment: slip,
                     slip_velocity,
@@ -120,12 +120,30 @@ impl Dda {
                 // symmetric); iterate until it moves by < 1e-4: the friction force is then
                 // within 1e-4·ρN of the implicit one, far below the accuracy targets, while a
                 // tighter bound only buys passes when the penalty springs ring.
-                if let ContactState::Sliding { .. } = new_state
-                    && (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha)
+                // The sliding coefficient, at the α point's slip speed, settles the same way.
+                let mu_alpha = match mode {
+                    Mode::Static { friction: Some(f) } => f,
+                    _ => c.props.friction.sliding_coefficient(
+                        alpha_f * c.start_slip_velocity + (1.0 - alpha_f) * slip_velocity,
+                    ),
+                };
+                let sliding = matches!(new_state, ContactState::Sliding { .. });
+                let mu_moved = (mu_alpha - c.sliding_coefficient).abs()
+                    > 1e-4 * mu_alpha.max(c.sliding_coefficient);
+                if sliding
+                    && (mu_moved
+                        || (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha))
                 {
                     changed = true;
                 }
                 c.friction_normal = n_alpha;
+                // A coefficient within the tolerance is left as the solve used it, so that
+                // the friction work booked and the force carried into the next step are
+                // the ones the step was solved with (the energy balance of a velocity law
+                // closed to 1e-6 only when the settled pass's re-evaluation was booked).
+                if mu_moved || !sliding {
+                    c.sliding_coefficient = mu_alpha;
+                }
                 // A contact that keeps flipping within one step (stuck ↔ sliding with the
                 // penalty spring's unresolved dynamics on either side of the limit) keeps
                 // its latest state: the step is then decided, at a small cost in accuracy,
@@ -384,8 +402,12 @@ pub(super) fn transition_fraction(
         (ContactState::Locked, ContactState::Sliding { .. }) => {
             let f0 = shear_start.abs();
             let f1 = shear_end.abs();
-            let limit = c.props.friction * normal_end;
-            if f1 > f0 {
+            let limit = c.props.friction.sticking_coefficient() * normal_end;
+            if f0 >= limit {
+                // Already past the limit when the step began (a stuck start that the
+                // judge lets go at once, or a normal force that fell): the event is here.
+                0.0
+            } else if f1 > f0 {
                 (limit - f0) / (f1 - f0)
             } else {
                 1.0
@@ -429,11 +451,7 @@ pub(super) fn yield_stretch(c: &Contact, state: ContactState, gap_end: f64) -> O
         ContactState::Locked => None,
         ContactState::Sliding { direction } => {
             let n = c.props.normal_penalty * (-gap_end).max(0.0);
-            let f = if c.props.friction.is_finite() {
-                c.props.friction * n
-            } else {
-                0.0
-            };
+            let f = c.props.friction.sliding_coefficient(c.end_slip_velocity) * n;
             Some(direction * f / c.props.shear_penalty)
         }
     }

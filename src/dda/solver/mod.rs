@@ -23,6 +23,7 @@ use super::contact::{
     self, Contact, ContactMemories, ContactMemory, ContactPair, JointProps, dot6,
 };
 use super::energy::EnergyTerms;
+use super::friction::FrictionLaw;
 use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
 use super::judge::{ContactState, JudgeInput, judge};
 use super::linear::{BlockPattern, LinearSolver, SolveError, TINY_LIMIT};
@@ -583,7 +584,7 @@ impl Dda {
             ContactState::Locked if self.augmented() => -c.shear_multiplier,
             ContactState::Locked => c.props.shear_penalty * c.shear0,
             ContactState::Sliding { direction } => {
-                direction * c.props.friction.min(1e30) * c.friction_normal
+                direction * c.sliding_coefficient * c.friction_normal
             }
         };
         (normal, tangential)

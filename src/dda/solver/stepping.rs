@@ -81,10 +81,14 @@ impl Dda {
                     ContactState::Open => (0.0, 0.0, 0.0),
                     ContactState::Locked => (stuck_stretch, normal, c.shear_multiplier),
                     ContactState::Sliding { direction } => {
-                        let mu = if c.props.friction.is_finite() {
-                            c.props.friction
+                        // A speed-dependent law: the coefficient the step was solved with (at
+                        // the α point, as iterated), so that the next step starts from the
+                        // force this one used and booked. (A constant law's own value also
+                        // after a settle that overrode it: see NOTES-issue-13.)
+                        let mu = if c.props.friction.depends_on_speed() {
+                            c.sliding_coefficient
                         } else {
-                            0.0
+                            c.props.friction.sliding_coefficient(c.end_slip_velocity)
                         };
                         (0.0, normal, -direction * mu * normal.max(0.0))
                     }
@@ -413,7 +417,7 @@ impl Dda {
             }
             if let ContactState::Sliding { direction } = ct.state {
                 sliding += 1;
-                let f = ct.props.friction * ct.friction_normal;
+                let f = ct.sliding_coefficient * ct.friction_normal;
                 dissipated += if augmented {
                     // The friction force on the vertex, averaged over the step's ends (at
                     // its start, whatever the contact carried then), times the slip.

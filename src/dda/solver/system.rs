@@ -139,7 +139,7 @@ impl Dda {
                     // as generalised forces that is −δρN·(slip_i, slip_j).
                     let friction = match mode {
                         Mode::Static { friction: Some(f) } => f,
-                        _ => c.props.friction,
+                        _ => c.sliding_coefficient,
                     };
                     let f = -direction * friction * c.friction_normal;
                     if let Some(s) = self.dofs.slot[i] {
