@@ -255,7 +255,10 @@ fn pga_scaling_and_friction_variants_go_through_the_run_setup() {
         .iter()
         .find(|c| c.name == recorded.joint)
         .unwrap();
-    assert_eq!(joint.friction.sticking(), 0.2);
+    assert_eq!(
+        slidebase::dda::FrictionLaw::sticking_coefficient(&joint.friction),
+        0.2
+    );
     let e = recorded
         .friction_variant_scene(f64::NAN)
         .unwrap_err()

@@ -13,9 +13,8 @@
 use rustc_hash::FxHashMap;
 
 use super::block::{Block, EdgeFrame, Vec6, t_transpose_times};
-use super::friction::FrictionLaw;
 use super::judge::ContactState;
-use crate::model::friction::Friction;
+use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::geometry::{Point, contains, cross, dot, sub};
 
 /// What the contacts of the last step remember, by key.

@@ -11,7 +11,6 @@ pub mod assembly;
 pub mod block;
 pub mod contact;
 pub mod energy;
-pub mod friction;
 pub mod integrator;
 pub mod joints;
 pub mod judge;
@@ -19,7 +18,7 @@ pub mod linear;
 pub mod params;
 pub mod solver;
 
+pub use crate::model::friction::FrictionLaw;
 pub use energy::EnergyTerms;
-pub use friction::FrictionLaw;
 pub use params::{ContactEnforcement, Integrator, SolverParams};
 pub use solver::{Dda, Modes, RunCounters, StepReport};

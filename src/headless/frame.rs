@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::simulate::{self, ModelRun, SPECTRUM_DT, SPECTRUM_MAX_SAMPLES};
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
-use crate::dda::{Dda, Integrator, SolverParams};
+use crate::dda::{Dda, FrictionLaw, Integrator, SolverParams};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::Scene;
 use crate::model::scene::{ExcitationDef, StructureRoles};
@@ -326,7 +326,7 @@ pub fn equivalent_mdof_with(
         .contacts
         .iter()
         .find(|c| c.name == r.joint)
-        .map_or(0.0, |c| c.friction.sticking());
+        .map_or(0.0, |c| c.friction.sticking_coefficient());
     let storey_masses = masses[1..].to_vec();
     let (stiffnesses, fit_error) = fit_storey_stiffnesses(&storey_masses, &report.frequencies_hz)?;
     let report = ModesReport {

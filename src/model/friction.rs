@@ -3,8 +3,9 @@
 //! A law says how much tangential force a closed joint holds while stuck (the sticking
 //! coefficient, times the normal force) and how much it carries while slipping (the
 //! sliding coefficient, which may depend on the slip speed). The solver asks exactly these
-//! two questions through [`crate::dda::FrictionLaw`], so a new law is a new variant here
-//! and its two answers there.
+//! questions, through the [`FrictionLaw`] trait, so that the judge, the assembly, the event
+//! resolution and the energy ledger never look at a law's parameters: a new law is a new
+//! variant here and its answers in the trait's implementation.
 //!
 //! Written forms (the same in TOML and on the command line):
 //!
@@ -49,9 +50,28 @@ pub enum Friction {
     },
 }
 
-impl Friction {
-    /// The coefficient a stuck joint holds: the largest tangential force is this times N.
-    pub fn sticking(&self) -> f64 {
+/// A friction law as the solver sees it.
+///
+/// The open-close judge compares a stuck contact's tangential force with the sticking
+/// coefficient times N; a sliding contact carries the sliding coefficient at its slip speed
+/// times N, evaluated at the integrator's α point and iterated within the step like the
+/// normal force it multiplies (docs/friction-laws.md).
+pub trait FrictionLaw {
+    /// Coefficient of the largest tangential force a stuck contact holds, per unit normal
+    /// force (+∞: never slides; 0: always slides).
+    fn sticking_coefficient(&self) -> f64;
+
+    /// Coefficient of the friction force of a contact slipping at `slip_speed` (m/s, either
+    /// sign), per unit normal force; finite.
+    fn sliding_coefficient(&self, slip_speed: f64) -> f64;
+
+    /// Whether the sliding coefficient changes with the slip speed (the open-close
+    /// iteration then also waits for it to settle).
+    fn depends_on_speed(&self) -> bool;
+}
+
+impl FrictionLaw for Friction {
+    fn sticking_coefficient(&self) -> f64 {
         match *self {
             Friction::Coulomb(mu) => mu,
             Friction::StaticKinetic { stick, .. } => stick,
@@ -59,9 +79,8 @@ impl Friction {
         }
     }
 
-    /// The coefficient of the friction force of a joint slipping at `slip_speed` (m/s).
     /// A joint that never slides (`inf`) reports 0: it can carry no sliding force.
-    pub fn sliding(&self, slip_speed: f64) -> f64 {
+    fn sliding_coefficient(&self, slip_speed: f64) -> f64 {
         let mu = match *self {
             Friction::Coulomb(mu) => mu,
             Friction::StaticKinetic { slide, .. } => slide,
@@ -72,12 +91,12 @@ impl Friction {
         if mu.is_finite() { mu } else { 0.0 }
     }
 
-    /// Whether the sliding force depends on the slip speed (the solver then iterates on
-    /// it within a step).
-    pub fn depends_on_speed(&self) -> bool {
+    fn depends_on_speed(&self) -> bool {
         matches!(self, Friction::Velocity { slow, fast, .. } if slow != fast)
     }
+}
 
+impl Friction {
     /// Checks the coefficients; the message says what would be accepted.
     pub fn check(&self) -> Result<(), String> {
         let coefficient = |name: &str, mu: f64| {
@@ -232,18 +251,27 @@ mod tests {
             fast: 0.12,
             rate: 20.0,
         };
-        assert_eq!(law.sticking(), 0.05);
-        assert_eq!(law.sliding(0.0), 0.05);
+        assert_eq!(law.sticking_coefficient(), 0.05);
+        assert_eq!(law.sliding_coefficient(0.0), 0.05);
         // One e-folding at v = 1/RATE, symmetric in the slip direction.
         let at = 0.12 - 0.07 * (-1.0_f64).exp();
-        assert!((law.sliding(0.05) - at).abs() < 1e-15);
-        assert_eq!(law.sliding(-0.05), law.sliding(0.05));
-        assert!((law.sliding(10.0) - 0.12).abs() < 1e-15);
+        assert!((law.sliding_coefficient(0.05) - at).abs() < 1e-15);
+        assert_eq!(
+            law.sliding_coefficient(-0.05),
+            law.sliding_coefficient(0.05)
+        );
+        assert!((law.sliding_coefficient(10.0) - 0.12).abs() < 1e-15);
     }
 
     #[test]
     fn a_joint_that_never_slides_carries_no_sliding_force() {
-        assert_eq!(Friction::Coulomb(f64::INFINITY).sliding(1.0), 0.0);
-        assert_eq!(Friction::Coulomb(f64::INFINITY).sticking(), f64::INFINITY);
+        assert_eq!(
+            Friction::Coulomb(f64::INFINITY).sliding_coefficient(1.0),
+            0.0
+        );
+        assert_eq!(
+            Friction::Coulomb(f64::INFINITY).sticking_coefficient(),
+            f64::INFINITY
+        );
     }
 }

@@ -9,7 +9,7 @@ use super::{check, defaults};
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
-use crate::model::friction::Friction;
+use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground};
 use crate::model::scene::{ExcitationDef, StructureRoles, TwoBlockRoles};
 use crate::{Error, Result};
@@ -131,7 +131,7 @@ impl RunSpec {
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            law.sticking()
+            law.sticking_coefficient()
         };
         let structure_hz = roles.structure_frequency_hz;
         // The scene's own harmonic input, as (amplitude, Ω/ω).
@@ -321,7 +321,7 @@ impl RunSpec {
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            self.joint_law(&scene, &roles.joint)?.sticking()
+            self.joint_law(&scene, &roles.joint)?.sticking_coefficient()
         };
         let roof = roles.floors.last().unwrap_or(&roles.base).clone();
         let blocks = [roles.base.clone(), roof, roles.joint.clone()];

@@ -23,12 +23,12 @@ use super::contact::{
     self, Contact, ContactMemories, ContactMemory, ContactPair, JointProps, dot6,
 };
 use super::energy::EnergyTerms;
-use super::friction::FrictionLaw;
 use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
 use super::judge::{ContactState, JudgeInput, judge};
 use super::linear::{BlockPattern, LinearSolver, SolveError, TINY_LIMIT};
 use super::params::{AlphaCoefficients, SolverParams};
 use crate::ground_motion::GroundMotion;
+use crate::model::friction::FrictionLaw;
 use crate::model::geometry::{self, Point};
 use crate::model::scene::{FixedDirection, GroundKind, Scene};
 use crate::{Error, Result};
