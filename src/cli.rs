@@ -13,7 +13,7 @@ use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, parse_s
 use slidebase::model::friction::Friction;
 use slidebase::model::scene::GroundKind;
 use slidebase::post::output::Staged;
-use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
+use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneRoles};
 
 /// Buildings on a sliding (friction) base under earthquakes, computed with Discontinuous
 /// Deformation Analysis and checked against the exact mass-spring solution.
@@ -76,7 +76,9 @@ enum GroundArg {
 
 #[derive(Debug, clap::Args)]
 struct RunArgs {
-    /// Built-in scene name or a scene TOML file.
+    /// Built-in scene (`two-block`, `three-storey`, `block`: Newmark's sliding block;
+    /// `slidebase list` names them all), a generated one (`frame:N`, `wall:N`) or a scene
+    /// TOML file.
     #[arg(long, default_value = "two-block")]
     scene: String,
     /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1) (two-block scenes;
@@ -408,17 +410,14 @@ fn cmd_run(args: RunArgs) -> Result<()> {
             HistoryPlan::EverySteps(1)
         };
     }
-    if setup.two_block().is_none() {
-        return cmd_run_frame(&args, &setup);
+    match setup.roles {
+        SceneRoles::TwoBlock { .. } => {}
+        SceneRoles::Building(_) => return cmd_run_frame(&args, &setup),
+        SceneRoles::Block(_) => return cmd_run_block(&args, &setup),
     }
     let outcome = run_setup(&setup)?;
     if let Some(dir) = &args.out {
-        let files = write_outputs(&outcome, dir)?;
-        if !args.json {
-            for f in files {
-                out(&format!("wrote {}", f.display()))?;
-            }
-        }
+        list_written(write_outputs(&outcome, dir)?, args.json)?;
     }
     let s = &outcome.summary;
     if args.json {
@@ -640,6 +639,30 @@ fn cmd_bench(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
+/// Lists the files a run wrote (not with `--json`, whose stdout is the one object).
+fn list_written(files: Vec<std::path::PathBuf>, json: bool) -> Result<()> {
+    if !json {
+        for f in files {
+            out(&format!("wrote {}", f.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// The first line of a building or block run's text summary.
+fn run_header(
+    scene: &str,
+    model: &str,
+    integrator: Option<&str>,
+    record: &str,
+    friction: Option<String>,
+    duration_s: f64,
+) -> String {
+    let integrator = integrator.map_or(String::new(), |i| format!(", {i}"));
+    let friction = friction.unwrap_or_else(|| "fixed base".into());
+    format!("{scene} ({model}{integrator}), {record}, {friction}, {duration_s:.2} s")
+}
+
 /// Prints a run's warnings on stderr (the JSON carries them too).
 fn warn(warnings: &[String]) {
     for w in warnings {
@@ -650,29 +673,24 @@ fn warn(warnings: &[String]) {
 fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<()> {
     let outcome = slidebase::headless::frame::run_building_setup(setup)?;
     if let Some(dir) = &args.out {
-        let files = slidebase::headless::frame::write_outputs(&outcome, dir)?;
-        if !args.json {
-            for f in files {
-                out(&format!("wrote {}", f.display()))?;
-            }
-        }
+        list_written(
+            slidebase::headless::frame::write_outputs(&outcome, dir)?,
+            args.json,
+        )?;
     }
     let s = &outcome.summary;
     if args.json {
         return out(&serde_json::to_string(s)?);
     }
     warn(&s.warnings);
-    out(&format!(
-        "{} ({}{}), {}, {}, {:.2} s",
-        s.scene,
-        s.model,
-        s.integrator
-            .as_ref()
-            .map_or(String::new(), |i| format!(", {i}")),
-        s.record,
-        s.friction
-            .map_or("fixed base".into(), |f| format!("ρ = {f}")),
-        s.duration_s
+    let friction = s.friction.map(|f| format!("ρ = {f}"));
+    out(&run_header(
+        &s.scene,
+        &s.model,
+        s.integrator.as_deref(),
+        &s.record,
+        friction,
+        s.duration_s,
     ))?;
     out(&format!(
         "  max slip              {:.4} m (residual {:.4} m)",
@@ -693,6 +711,48 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     if let Some(f) = s.base_accel_peak_freq_hz {
         out(&format!("  base accel spectrum   peak at {f:.3} Hz"))?;
     }
+    out(&format!(
+        "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
+        s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
+    ))
+}
+
+fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<()> {
+    use slidebase::headless::block;
+    let outcome = block::run_block_setup(setup)?;
+    if let Some(dir) = &args.out {
+        // The exact block takes milliseconds: the figure shows the DDA slip against it.
+        let reference = match setup.model {
+            ModelKind::Dda => Some(block::run_exact_block(setup, setup.dt)?),
+            ModelKind::MassSpring => None,
+        };
+        list_written(
+            block::write_outputs(&outcome, reference.as_ref(), dir)?,
+            args.json,
+        )?;
+    }
+    let s = &outcome.summary;
+    if args.json {
+        return out(&serde_json::to_string(s)?);
+    }
+    warn(&s.warnings);
+    let friction = s.friction_law.as_ref().map(|f| format!("friction {f}"));
+    out(&run_header(
+        &s.scene,
+        &s.model,
+        s.integrator.as_deref(),
+        &s.record,
+        friction,
+        s.duration_s,
+    ))?;
+    out(&format!(
+        "  max slip              {:.4} m (residual {:.4} m)",
+        s.max_slip_m, s.residual_slip_m
+    ))?;
+    out(&format!(
+        "  peak block accel      {:.4} g  (ground {:.4} g)",
+        s.peak_base_accel_g, s.peak_ground_accel_g
+    ))?;
     out(&format!(
         "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
         s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
@@ -1159,11 +1219,18 @@ mod tests {
                         if !small {
                             return Ok(Some(false));
                         }
-                        let json = if setup.two_block().is_some() {
-                            serde_json::to_string(&run_setup(&setup)?.summary)?
-                        } else {
-                            let o = slidebase::headless::frame::run_building_setup(&setup)?;
-                            serde_json::to_string(&o.summary)?
+                        let json = match setup.roles {
+                            SceneRoles::TwoBlock { .. } => {
+                                serde_json::to_string(&run_setup(&setup)?.summary)?
+                            }
+                            SceneRoles::Building(_) => {
+                                let o = slidebase::headless::frame::run_building_setup(&setup)?;
+                                serde_json::to_string(&o.summary)?
+                            }
+                            SceneRoles::Block(_) => {
+                                let o = slidebase::headless::block::run_block_setup(&setup)?;
+                                serde_json::to_string(&o.summary)?
+                            }
                         };
                         assert!(!json.contains("null"), "{args:?}: {json}");
                         Ok(Some(true))

@@ -54,6 +54,40 @@ fn run_json_has_the_documented_keys() {
     assert_eq!(v["steps"].as_u64().map(|s| s >= 5000), Some(true));
 }
 
+/// `--scene block` reports the slip and the block's acceleration under the documented
+/// names, from both models, and refuses the two-block flags.
+#[test]
+fn block_scene_json_has_the_documented_keys() {
+    for model in ["dda", "mass-spring"] {
+        let v = json_of(&slidebase(&[
+            "run",
+            "--scene",
+            "block",
+            "--model",
+            model,
+            "--duration",
+            "5",
+            "--json",
+        ]));
+        for key in [
+            "max_slip_m",
+            "residual_slip_m",
+            "peak_base_accel_g",
+            "steps",
+        ] {
+            assert!(
+                v.get(key).is_some_and(|x| x.is_number()),
+                "{model}: missing or non-numeric {key}: {v}"
+            );
+        }
+        assert_eq!(v["scene"], "block");
+        assert_eq!(v["model"], model);
+    }
+    let out = slidebase(&["run", "--scene", "block", "--alpha", "0.5"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--alpha"));
+}
+
 #[test]
 fn mass_spring_model_and_outputs() {
     let dir = tempfile::tempdir().unwrap();

@@ -18,6 +18,7 @@ use slidebase::model::scene::GroundKind;
 use slidebase::post::sweep::{SweepRow, read_sweep_csv, write_sweep_csv};
 use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 
+const BLOCK: &str = include_str!("../assets/scenes/block.toml");
 const TWO_BLOCK: &str = include_str!("../assets/scenes/two-block.toml");
 const THREE_STOREY: &str = include_str!("../assets/scenes/three-storey.toml");
 
@@ -285,6 +286,17 @@ fn scene_roles_are_checked() {
     assert_has(&e, &["structure.floors", "bottom to top"]);
     let e = scene_error(&TWO_BLOCK.replace("roof = \"roof\"", "roof = \"raft\""));
     assert_has(&e, &["two_block.roof", "also the raft"]);
+    let e = scene_error(&BLOCK.replace("block = \"block\"\njoint", "block = \"ground\"\njoint"));
+    assert_has(&e, &["sliding_block.block", "is the ground"]);
+    let e = scene_error(&BLOCK.replace("joint = \"sliding-joint\"", "joint = \"nothing\""));
+    assert_has(&e, &["sliding_block.joint", "no contact named 'nothing'"]);
+    // One kind of roles per scene: each makes runs measure different blocks.
+    let both =
+        format!("{BLOCK}\n[structure]\nbase = \"block\"\nfloors = []\njoint = \"sliding-joint\"\n");
+    assert_has(
+        &scene_error(&both),
+        &["[structure] and [sliding_block]", "give one of"],
+    );
 }
 
 #[test]

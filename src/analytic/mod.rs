@@ -7,12 +7,17 @@
 //! form, forced part by Gauss–Legendre quadrature of the Duhamel integral over short steps
 //! on which the forcing is smooth), and the stick/slip switching times are found by root
 //! finding. This is the reference the DDA model is validated against.
+//!
+//! The sliding block (`block` scene) has its own exact solution with any friction law and
+//! vertical shaking ([`simulate_block`]).
 
 mod exact;
 mod sdof;
+mod sliding_block;
 
 pub use exact::{EnergyBalance, ExactOptions, ExactResult, Peaks, Phase, PhaseEvent, simulate};
 pub use sdof::sdof_harmonic_from_rest;
+pub use sliding_block::{BlockEnergy, BlockOptions, BlockResult, SlidingBlock, simulate_block};
 
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::{Error, Result};

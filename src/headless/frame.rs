@@ -181,11 +181,11 @@ pub fn run_building(spec: &RunSpec) -> Result<FrameOutcome> {
 
 /// Runs a prepared building setup.
 pub fn run_building_setup(setup: &RunSetup) -> Result<FrameOutcome> {
-    if setup.two_block().is_some() {
+    if !matches!(setup.roles, crate::setup::SceneRoles::Building(_)) {
         return Err(Error::invalid(
             "--scene",
             format!(
-                "scene '{}' is a two-block scene, not a building (no [structure] section)",
+                "scene '{}' is not a building (no [structure] section)",
                 setup.scene.name
             ),
         ));

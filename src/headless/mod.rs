@@ -5,6 +5,7 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod block;
 pub mod frame;
 pub mod report;
 pub mod run;

@@ -207,28 +207,65 @@ pub fn exact_model_run(
             ]);
         }
     }
-    ModelRun {
-        model: ModelKind::MassSpring,
-        peaks: Peaks {
+    ModelRun::exact(
+        Peaks {
             slip_m: r.peaks.slip,
             drift_m: r.peaks.roof_drift,
             base_accel: r.peaks.raft_accel,
             roof_accel: r.peaks.roof_accel,
             ground_accel: r.peaks.ground_accel,
         },
-        residual_slip_m: r.residual_slip,
-        steps: r.steps,
-        passes: 0,
-        cuts: 0,
-        factorizations: 0,
-        sliding_steps: 0,
-        max_penetration_ratio: 0.0,
-        energy_residual_rel,
-        input_work: r.energy.input_work * energy_scale,
-        friction_dissipated: r.energy.friction_dissipated * energy_scale,
-        wall_time_s: start.elapsed().as_secs_f64(),
+        r.residual_slip,
+        r.steps,
+        ExactEnergy {
+            residual_rel: energy_residual_rel,
+            input_work: r.energy.input_work * energy_scale,
+            friction_dissipated: r.energy.friction_dissipated * energy_scale,
+        },
         history,
-        base_accel_series: None,
+        start,
+    )
+}
+
+/// The energies an exact model reports, J per m of thickness.
+#[derive(Debug, Clone, Copy)]
+pub struct ExactEnergy {
+    /// Residual relative to the energy through the model.
+    pub residual_rel: f64,
+    /// Input work.
+    pub input_work: f64,
+    /// Friction dissipation.
+    pub friction_dissipated: f64,
+}
+
+impl ModelRun {
+    /// The run of an exact (event-driven) model, which has none of DDA's counters;
+    /// `start` is when it began (for the wall time).
+    pub fn exact(
+        peaks: Peaks,
+        residual_slip_m: f64,
+        steps: u64,
+        energy: ExactEnergy,
+        history: History,
+        start: Instant,
+    ) -> Self {
+        Self {
+            model: ModelKind::MassSpring,
+            peaks,
+            residual_slip_m,
+            steps,
+            passes: 0,
+            cuts: 0,
+            factorizations: 0,
+            sliding_steps: 0,
+            max_penetration_ratio: 0.0,
+            energy_residual_rel: energy.residual_rel,
+            input_work: energy.input_work,
+            friction_dissipated: energy.friction_dissipated,
+            wall_time_s: start.elapsed().as_secs_f64(),
+            history,
+            base_accel_series: None,
+        }
     }
 }
 

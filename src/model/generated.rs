@@ -214,6 +214,7 @@ fn building(
             scale: 1.0,
         },
         two_block: None,
+        sliding_block: None,
         structure: Some(StructureRoles {
             base: "base-slab".into(),
             floors,

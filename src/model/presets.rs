@@ -13,6 +13,7 @@ const BUILTIN: &[(&str, &str)] = &[
         "two-block",
         include_str!("../../assets/scenes/two-block.toml"),
     ),
+    ("block", include_str!("../../assets/scenes/block.toml")),
     (
         "three-storey",
         include_str!("../../assets/scenes/three-storey.toml"),

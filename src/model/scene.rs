@@ -57,6 +57,9 @@ pub struct Scene {
     /// Roles of a building scene: which blocks are the base and the floors.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub structure: Option<StructureRoles>,
+    /// Roles of a sliding-block scene: the block and its joint (Newmark's sliding block).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sliding_block: Option<SlidingBlockRoles>,
 }
 
 /// Names the parts of a building so that runs can report slip, drift and floor responses.
@@ -325,6 +328,16 @@ mod strict {
             ))),
         }
     }
+}
+
+/// Names the parts of a sliding-block scene: one block on the ground across a joint.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SlidingBlockRoles {
+    /// The sliding block.
+    pub block: String,
+    /// The joint between the block and the ground (contact name).
+    pub joint: String,
 }
 
 /// Names the parts of a two-mass scene (paper Fig. 2) so that α, ρ and Ω/ω can be set.

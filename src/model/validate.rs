@@ -164,8 +164,67 @@ pub fn check(scene: &Scene) -> Check {
     check_excitation(scene)?;
     check_span(scene, ground)?;
     check_overlaps(scene)?;
+    check_one_role_section(scene)?;
     check_structure_roles(scene, &names, ground)?;
+    check_sliding_block_roles(scene, &names, ground)?;
     check_two_block_roles(scene, &names, ground)
+}
+
+/// A scene is a two-block model, a building or a sliding block: at most one of the role
+/// sections, since each makes runs measure different blocks.
+fn check_one_role_section(scene: &Scene) -> Check {
+    let given: Vec<&str> = [
+        ("two_block", scene.two_block.is_some()),
+        ("structure", scene.structure.is_some()),
+        ("sliding_block", scene.sliding_block.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(name, given)| given.then_some(name))
+    .collect();
+    if given.len() > 1 {
+        return Err(Issue::new(
+            At::Table(
+                if scene.sliding_block.is_some() {
+                    "sliding_block"
+                } else {
+                    "structure"
+                },
+                None,
+            ),
+            given.join(", "),
+            format!(
+                "the scene declares [{}]: give one of [two_block], [structure] and \
+                 [sliding_block], the roles its runs measure",
+                given.join("] and [")
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn check_sliding_block_roles(scene: &Scene, names: &HashMap<&str, usize>, ground: usize) -> Check {
+    let Some(r) = &scene.sliding_block else {
+        return Ok(());
+    };
+    let at = |key| At::Table("sliding_block", Some(key));
+    let block = block_of(names, &r.block, at("block"), "sliding_block.block")?;
+    if block == ground {
+        return Err(Issue::new(
+            at("block"),
+            "sliding_block.block",
+            format!(
+                "'{}' is the ground; name the block that slides on it",
+                r.block
+            ),
+        ));
+    }
+    check_joint(
+        scene,
+        &r.joint,
+        [&r.block, &scene.ground.block],
+        at("joint"),
+        "sliding_block.joint",
+    )
 }
 
 fn block_list(scene: &Scene) -> String {

@@ -122,7 +122,7 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
             return Err(Error::invalid(
                 "--alpha",
                 format!(
-                    "sets the mass ratio of the two-block scene; '{}' is a building (its \
+                    "sets the mass ratio of the two-block scene; '{}' is not one (its \
                      masses are its blocks')",
                     scene.name
                 ),
@@ -153,6 +153,15 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
 /// The number of steps the exact model takes: a 32nd of the shortest period of the stick
 /// and slip phases or the excitation, and every record sample.
 fn exact_steps(setup: &RunSetup) -> Option<f64> {
+    if let super::SceneRoles::Block(_) = setup.roles {
+        let block = crate::analytic::SlidingBlock {
+            friction: setup.joint_law(),
+            gravity: setup.scene.gravity,
+            horizontal: &setup.motion,
+            vertical: None,
+        };
+        return Some(block.steps(setup.duration, &Default::default()));
+    }
     let (roles, alpha, _) = setup.two_block()?;
     // The slip phase's structure frequency ω/√(1 − α) is the higher one.
     let structure = roles.structure_frequency_hz / (1.0 - alpha).sqrt();

@@ -11,7 +11,7 @@ use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
 use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground};
-use crate::model::scene::{ExcitationDef, StructureRoles, TwoBlockRoles};
+use crate::model::scene::{ExcitationDef, SlidingBlockRoles, StructureRoles, TwoBlockRoles};
 use crate::{Error, Result};
 
 /// What kind of scene a run is on, with its roles.
@@ -28,6 +28,8 @@ pub enum SceneRoles {
     },
     /// A building (a `[structure]` scene).
     Building(StructureRoles),
+    /// Newmark's sliding block (a `[sliding_block]` scene).
+    Block(SlidingBlockRoles),
 }
 
 /// A run ready to start: validated, with every default resolved.
@@ -83,12 +85,14 @@ impl RunSpec {
             self.two_block(scene, roles)?
         } else if let Some(roles) = scene.structure.clone() {
             self.building(scene, roles)?
+        } else if let Some(roles) = scene.sliding_block.clone() {
+            self.sliding_block(scene, roles)?
         } else {
             return Err(Error::invalid(
                 "--scene",
                 format!(
-                    "scene '{}' declares no [two_block] or [structure] roles, so a run \
-                     does not know which blocks are the base and the roof",
+                    "scene '{}' declares no [two_block], [structure] or [sliding_block] \
+                     roles, so a run does not know which blocks are the base and the roof",
                     scene.name
                 ),
             ));
@@ -257,6 +261,28 @@ impl RunSpec {
         if let Some(law) = self.law_given() {
             set_joint_law(&mut scene, &roles.joint, law);
         }
+        let motion = self.scene_or_given_motion(&scene)?;
+        let friction = if self.fixed_base {
+            f64::INFINITY
+        } else {
+            self.joint_law(&scene, &roles.joint)?.sticking_coefficient()
+        };
+        let roof = roles.floors.last().unwrap_or(&roles.base).clone();
+        let blocks = [roles.base.clone(), roof, roles.joint.clone()];
+        let label = motion.label();
+        Ok(self.setup(
+            scene,
+            motion,
+            SceneRoles::Building(roles),
+            blocks,
+            friction,
+            label,
+        ))
+    }
+
+    /// The ground motion of a building or block scene: the specification's, or the
+    /// scene's own.
+    fn scene_or_given_motion(&self, scene: &Scene) -> Result<GroundMotion> {
         let motion = match (&self.excitation, &scene.excitation) {
             (ExcitationSpec::Record { source, scale }, _)
             | (
@@ -318,18 +344,33 @@ impl RunSpec {
                 GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude, hz)?)
             }
         };
+        Ok(motion)
+    }
+
+    /// Newmark's sliding block: friction and excitation set on the scene as it is.
+    fn sliding_block(&self, mut scene: Scene, roles: SlidingBlockRoles) -> Result<RunSetup> {
+        if let Some(law) = self.law_given() {
+            set_joint_law(&mut scene, &roles.joint, law);
+        }
+        let motion = self.scene_or_given_motion(&scene)?;
+        // The block's exact model has every law: no refusal for `--model mass-spring`.
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            self.joint_law(&scene, &roles.joint)?.sticking_coefficient()
+            self.run_law(&scene, &roles.joint).sticking_coefficient()
         };
-        let roof = roles.floors.last().unwrap_or(&roles.base).clone();
-        let blocks = [roles.base.clone(), roof, roles.joint.clone()];
+        // The block is its own base and roof: drift is zero, the base acceleration is the
+        // block's.
+        let blocks = [
+            roles.block.clone(),
+            roles.block.clone(),
+            roles.joint.clone(),
+        ];
         let label = motion.label();
         Ok(self.setup(
             scene,
             motion,
-            SceneRoles::Building(roles),
+            SceneRoles::Block(roles),
             blocks,
             friction,
             label,
@@ -342,12 +383,10 @@ impl RunSpec {
         self.friction.map(Friction::Coulomb).or(self.friction_law)
     }
 
-    /// The friction law of the named joint as the run will have it (`--friction` replaces
-    /// the scene's law by Coulomb's), refused for the exact mass-spring model unless it is
-    /// Coulomb's: that model has no other law, and running it with the sticking
-    /// coefficient alone would compare different physics without a word.
-    fn joint_law(&self, scene: &Scene, joint: &str) -> Result<Friction> {
-        let law = match self.law_given() {
+    /// The friction law of the named joint as the run will have it: the specification's,
+    /// or the scene's.
+    fn run_law(&self, scene: &Scene, joint: &str) -> Friction {
+        match self.law_given() {
             Some(law) => law,
             // The scene's validation makes sure the joint exists.
             None => scene
@@ -355,7 +394,15 @@ impl RunSpec {
                 .iter()
                 .find(|c| c.name == joint)
                 .map_or(Friction::Coulomb(0.0), |c| c.friction),
-        };
+        }
+    }
+
+    /// The friction law of the named joint as the run will have it (`--friction` replaces
+    /// the scene's law by Coulomb's), refused for the exact mass-spring model unless it is
+    /// Coulomb's: that model has no other law, and running it with the sticking
+    /// coefficient alone would compare different physics without a word.
+    fn joint_law(&self, scene: &Scene, joint: &str) -> Result<Friction> {
+        let law = self.run_law(scene, joint);
         if self.model == ModelKind::MassSpring
             && !self.fixed_base
             && !matches!(law, Friction::Coulomb(_))
@@ -395,6 +442,18 @@ impl RunSetup {
         Ok((dda, probe))
     }
 
+    /// The sliding joint's friction law as run (Coulomb's ∞ for a fixed base).
+    pub fn joint_law(&self) -> Friction {
+        if self.fixed_base {
+            return Friction::Coulomb(f64::INFINITY);
+        }
+        self.scene
+            .contacts
+            .iter()
+            .find(|c| c.name == self.joint)
+            .map_or(Friction::Coulomb(self.friction), |c| c.friction)
+    }
+
     /// The run's scene with the sliding joint bonded (the fixed-base comparison).
     pub fn fixed_base_scene(&self) -> Scene {
         let mut scene = self.scene.clone();
@@ -427,7 +486,7 @@ impl RunSetup {
                 alpha,
                 freq_ratio,
             } => Some((roles, *alpha, *freq_ratio)),
-            SceneRoles::Building(_) => None,
+            SceneRoles::Building(_) | SceneRoles::Block(_) => None,
         }
     }
 }

@@ -1,0 +1,261 @@
+//! Newmark's sliding block (`--scene block`): the DDA model of one block on its joint, or
+//! its exact event-driven rigid-block solution, summarised in the same terms.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::simulate::{self, ExactEnergy, HISTORY_COLUMNS, ModelRun, Peaks};
+use crate::analytic::{BlockOptions, SlidingBlock, simulate_block};
+use crate::ground_motion::STANDARD_GRAVITY;
+use crate::post::history::History;
+use crate::post::plot::{Figure, Series};
+use crate::setup::{ModelKind, RunSetup, RunSpec, SceneRoles};
+use crate::{Error, Result};
+
+/// Summary of a sliding-block run (the JSON object of `run --json`). A quantity that is
+/// undefined for the run is left out (never `null`), and `warnings` says why.
+#[derive(Debug, Clone, Serialize)]
+pub struct BlockSummary {
+    /// Scene.
+    pub scene: String,
+    /// `dda` or `mass-spring` (the exact rigid block).
+    pub model: String,
+    /// Integrator (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integrator: Option<String>,
+    /// Record name (or the harmonic input).
+    pub record: String,
+    /// The joint's friction law as written (`0.15`, `static-kinetic:0.3,0.2`…; absent for
+    /// a fixed base).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_law: Option<String>,
+    /// Its sticking coefficient (absent for a fixed base).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// Fixed base (the joint bonded).
+    pub fixed_base: bool,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Nominal time step, s (DDA only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dt_s: Option<f64>,
+    /// Largest |slip| of the block relative to the ground, m.
+    pub max_slip_m: f64,
+    /// Slip at the end (block relative to ground, +x, signed), m.
+    pub residual_slip_m: f64,
+    /// Peak |absolute horizontal acceleration of the block|, g.
+    pub peak_base_accel_g: f64,
+    /// Peak ground acceleration, g.
+    pub peak_ground_accel_g: f64,
+    /// Time steps (DDA) or integration steps (exact model).
+    pub steps: u64,
+    /// Open-close passes (DDA).
+    pub open_close_passes: u64,
+    /// Δt cuts (DDA).
+    pub dt_cuts: u64,
+    /// Numeric factorisations of the system matrix (DDA).
+    pub factorizations: u64,
+    /// Largest penetration / block size (DDA).
+    pub max_penetration_ratio: f64,
+    /// Energy residual relative to the energy through the block.
+    pub energy_residual_rel: f64,
+    /// Work done by the ground on the block, J per m of thickness.
+    pub input_work_j: f64,
+    /// Energy dissipated by friction, J/m.
+    pub friction_dissipated_j: f64,
+    /// Wall-clock time, s.
+    pub wall_time_s: f64,
+    /// What the user should know.
+    pub warnings: Vec<String>,
+}
+
+/// A finished sliding-block run.
+#[derive(Debug, Clone)]
+pub struct BlockOutcome {
+    /// Summary.
+    pub summary: BlockSummary,
+    /// The full run (histories: [`HISTORY_COLUMNS`], the block as base and roof).
+    pub run: ModelRun,
+}
+
+/// Runs a sliding-block scene with the model the specification names.
+pub fn run_block(spec: &RunSpec) -> Result<BlockOutcome> {
+    run_block_setup(&spec.prepare()?)
+}
+
+/// Runs a prepared sliding-block setup.
+pub fn run_block_setup(setup: &RunSetup) -> Result<BlockOutcome> {
+    if !matches!(setup.roles, SceneRoles::Block(_)) {
+        return Err(Error::invalid(
+            "--scene",
+            format!(
+                "scene '{}' is not a sliding-block scene (no [sliding_block] section)",
+                setup.scene.name
+            ),
+        ));
+    }
+    let run = match setup.model {
+        ModelKind::Dda => simulate::run_dda(setup, &setup.scene, setup.solver_params())?,
+        ModelKind::MassSpring => run_exact_block(setup, setup.dt * setup.history.stride() as f64)?,
+    };
+    let summary = summarise(setup, &run);
+    super::run::check_finite(&summary, setup.duration)?;
+    Ok(BlockOutcome { summary, run })
+}
+
+/// Writes a sliding-block run's history, summary and figure into `dir` (all or nothing).
+/// The figure overlays `reference` (the exact rigid block, when the run is DDA's) on the
+/// slip, so that a reader sees at once how far the model is from the textbook block.
+pub fn write_outputs(
+    outcome: &BlockOutcome,
+    reference: Option<&ModelRun>,
+    dir: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>> {
+    let mut staged = crate::post::output::Staged::new(dir)?;
+    outcome.run.history.write_csv(&staged.path("history.csv"))?;
+    staged.write_json("summary.json", &outcome.summary)?;
+    if !outcome.run.history.is_empty() {
+        history_figure(outcome, reference).save_png(&staged.path("history.png"), 1400, 900)?;
+    }
+    staged.commit()
+}
+
+/// The block's acceleration against the ground's, and its slip (with the reference's).
+fn history_figure(outcome: &BlockOutcome, reference: Option<&ModelRun>) -> Figure {
+    let s = &outcome.summary;
+    let column = |h: &History, name: &str| h.column(name).map(<[f64]>::to_vec).unwrap_or_default();
+    let h = &outcome.run.history;
+    let t = column(h, "time_s");
+    let in_g = |v: Vec<f64>| {
+        v.into_iter()
+            .map(|a| a / STANDARD_GRAVITY)
+            .collect::<Vec<_>>()
+    };
+    let law = s.friction_law.as_deref().unwrap_or("bonded");
+    let mut fig = Figure::new(
+        format!("sliding block ({}), friction {law}, {}", s.model, s.record),
+        2,
+        1,
+    );
+    let p = &mut fig.panels[0];
+    p.title = format!(
+        "ground and block acceleration (block peak {:.3} g, ground {:.3} g)",
+        s.peak_base_accel_g, s.peak_ground_accel_g
+    );
+    p.x_label = "t (s)".into();
+    p.y_label = "a (g)".into();
+    p.series.push(Series::line(
+        "ground",
+        t.clone(),
+        in_g(column(h, "ground_accel_m_s2")),
+        6,
+    ));
+    p.series.push(Series::line(
+        "block",
+        t.clone(),
+        in_g(column(h, "base_accel_m_s2")),
+        1,
+    ));
+    let p = &mut fig.panels[1];
+    p.title = format!(
+        "slip of the block relative to the ground (peak {:.2} mm, residual {:.2} mm)",
+        1e3 * s.max_slip_m,
+        1e3 * s.residual_slip_m
+    );
+    p.x_label = "t (s)".into();
+    p.y_label = "slip (m)".into();
+    p.series
+        .push(Series::line(s.model.clone(), t, column(h, "slip_m"), 2));
+    if let Some(r) = reference {
+        // Markers (about 120 of them) so that the two curves stay apart to the eye where
+        // they agree.
+        let (rt, rs) = (column(&r.history, "time_s"), column(&r.history, "slip_m"));
+        let every = (rt.len() / 120).max(1);
+        let pick = |v: Vec<f64>| v.into_iter().step_by(every).collect::<Vec<_>>();
+        p.series
+            .push(Series::markers("exact rigid block", pick(rt), pick(rs), 0));
+    }
+    fig
+}
+
+/// The exact rigid block of a sliding-block setup, as a run (output every `output_dt`
+/// seconds, none if ≤ 0). Energies per unit mass are scaled by the DDA block's mass.
+pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
+    let start = Instant::now();
+    let block = SlidingBlock {
+        friction: setup.joint_law(),
+        gravity: setup.scene.gravity,
+        horizontal: &setup.motion,
+        vertical: None,
+    };
+    let output_dt = simulate::exact_output_dt(output_dt, setup.duration);
+    let r = simulate_block(&block, setup.duration, output_dt, &BlockOptions::default())?;
+    let mut history = History::new(&HISTORY_COLUMNS);
+    for k in 0..r.time.len() {
+        let t = r.time[k];
+        let a = r.accel[k];
+        history.push(&[t, setup.motion.accel(t), r.slip[k], 0.0, a, a]);
+    }
+    let mass = block_mass(setup)?;
+    let e = &r.energy;
+    // Relative to the energy that passed through the block (as the DDA ledger's).
+    let scale = e.input_work.abs().max(e.friction_dissipated + e.kinetic);
+    let energy = ExactEnergy {
+        residual_rel: if scale > 0.0 { e.residual / scale } else { 0.0 },
+        input_work: e.input_work * mass,
+        friction_dissipated: e.friction_dissipated * mass,
+    };
+    let peaks = Peaks {
+        slip_m: r.max_slip,
+        drift_m: 0.0,
+        base_accel: r.peak_accel,
+        roof_accel: r.peak_accel,
+        ground_accel: setup.motion.peak_accel(setup.duration),
+    };
+    Ok(ModelRun::exact(
+        peaks,
+        r.residual_slip,
+        r.steps,
+        energy,
+        history,
+        start,
+    ))
+}
+
+/// The sliding block's mass per metre of thickness, kg.
+fn block_mass(setup: &RunSetup) -> Result<f64> {
+    let b = &setup.scene.blocks[setup.scene.block_index(&setup.base)?];
+    Ok(b.material.density * crate::model::geometry::moments(&b.vertices, &b.name)?.area)
+}
+
+fn summarise(setup: &RunSetup, run: &ModelRun) -> BlockSummary {
+    let mut warnings = setup.warnings.clone();
+    let dda = setup.model == ModelKind::Dda;
+    let friction = super::run::reported_friction(setup, &mut warnings);
+    BlockSummary {
+        scene: setup.scene.name.clone(),
+        model: setup.model.label().into(),
+        integrator: dda.then(|| setup.integrator.label()),
+        record: setup.motion.label(),
+        friction_law: friction.map(|_| setup.joint_law().to_string()),
+        friction,
+        fixed_base: setup.fixed_base,
+        duration_s: setup.duration,
+        dt_s: dda.then_some(setup.dt),
+        max_slip_m: run.peaks.slip_m,
+        residual_slip_m: run.residual_slip_m,
+        peak_base_accel_g: run.peaks.base_accel / STANDARD_GRAVITY,
+        peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
+        steps: run.steps,
+        open_close_passes: run.passes,
+        dt_cuts: run.cuts,
+        factorizations: run.factorizations,
+        max_penetration_ratio: run.max_penetration_ratio,
+        energy_residual_rel: run.energy_residual_rel,
+        input_work_j: run.input_work,
+        friction_dissipated_j: run.friction_dissipated,
+        wall_time_s: run.wall_time_s,
+        warnings,
+    }
+}
