@@ -1,13 +1,15 @@
 #!/bin/bash
 # Newmark's sliding block: DDA (two integrators) against the exact rigid block, whole
 # records, three friction laws; prints the table of docs/sliding-block.md.
-# usage: scripts/block_table.sh target/release/slidebase
+# usage: scripts/block_table.sh target/release/slidebase [--vertical-record el-centro-up]
 B=$1
-for rec in el-centro kobe-nishi-akashi-000; do
+shift
+EXTRA="$*"
+for rec in ${RECORDS:-el-centro kobe-nishi-akashi-000}; do
 for law in 0.15 static-kinetic:0.2,0.12 velocity:0.08,0.16,10; do
-  ex=$($B run --scene block --record $rec --friction-law $law --model mass-spring --json)
+  ex=$($B run --scene block --record $rec --friction-law $law --model mass-spring $EXTRA --json)
   for integ in generalized-alpha:0 trapezoidal; do
-    dd=$($B run --scene block --record $rec --friction-law $law --integrator $integ --json)
+    dd=$($B run --scene block --record $rec --friction-law $law --integrator $integ $EXTRA --json)
     python3 - "$ex" "$dd" "$rec" "$law" "$integ" <<'PY'
 import json,sys
 e=json.loads(sys.argv[1]); d=json.loads(sys.argv[2])

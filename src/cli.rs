@@ -13,7 +13,9 @@ use slidebase::headless::sweep::{SweepRequest, parse_list, parse_ratios, parse_s
 use slidebase::model::friction::Friction;
 use slidebase::model::scene::GroundKind;
 use slidebase::post::output::Staged;
-use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneRoles};
+use slidebase::setup::{
+    ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneRoles, VerticalSpec,
+};
 
 /// Buildings on a sliding (friction) base under earthquakes, computed with Discontinuous
 /// Deformation Analysis and checked against the exact mass-spring solution.
@@ -119,6 +121,14 @@ struct RunArgs {
     /// Ground-motion record (built-in name or AT2/CSV file) instead of harmonic input.
     #[arg(long)]
     record: Option<String>,
+    /// Shake the ground vertically too, by this record (a vertical component, up
+    /// positive: `el-centro-up`, or an AT2/CSV file; default: the scene's, if any). The
+    /// normal force, and with it the friction capacity, follows N = m(g + a_v).
+    #[arg(long)]
+    vertical_record: Option<String>,
+    /// Factor on the vertical record's accelerations (default 1).
+    #[arg(long, requires = "vertical_record", allow_hyphen_values = true)]
+    vertical_scale: Option<f64>,
     /// Ground model of the DDA run (default: the scene's).
     #[arg(long, value_enum)]
     ground: Option<GroundArg>,
@@ -382,6 +392,10 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
         scene: args.scene.as_str().into(),
         model: args.model.into(),
         excitation,
+        vertical: args.vertical_record.as_ref().map(|source| VerticalSpec {
+            source: source.clone(),
+            scale: args.vertical_scale.unwrap_or(1.0),
+        }),
         alpha: args.alpha,
         friction: args.friction,
         friction_law: args.friction_law,
@@ -721,15 +735,8 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     use slidebase::headless::block;
     let outcome = block::run_block_setup(setup)?;
     if let Some(dir) = &args.out {
-        // The exact block takes milliseconds: the figure shows the DDA slip against it.
-        let reference = match setup.model {
-            ModelKind::Dda => Some(block::run_exact_block(setup, setup.dt)?),
-            ModelKind::MassSpring => None,
-        };
-        list_written(
-            block::write_outputs(&outcome, reference.as_ref(), dir)?,
-            args.json,
-        )?;
+        let overlays = block::standard_overlays(setup)?;
+        list_written(block::write_outputs(&outcome, &overlays, dir)?, args.json)?;
     }
     let s = &outcome.summary;
     if args.json {

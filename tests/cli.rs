@@ -54,6 +54,24 @@ fn run_json_has_the_documented_keys() {
     assert_eq!(v["steps"].as_u64().map(|s| s >= 5000), Some(true));
 }
 
+/// Runs `args` with `--out` into a new folder, checks that it succeeded and wrote the
+/// history, the summary and the figure, and returns the folder.
+fn run_with_out(args: &[&str]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let mut all = args.to_vec();
+    all.extend(["--out", dir.path().to_str().unwrap()]);
+    let out = slidebase(&all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["history.csv", "summary.json", "history.png"] {
+        assert!(dir.path().join(f).exists(), "{args:?}: {f} missing");
+    }
+    dir
+}
+
 /// `--scene block` reports the slip and the block's acceleration under the documented
 /// names, from both models, and refuses the two-block flags.
 #[test]
@@ -83,6 +101,15 @@ fn block_scene_json_has_the_documented_keys() {
         assert_eq!(v["scene"], "block");
         assert_eq!(v["model"], model);
     }
+    run_with_out(&[
+        "run",
+        "--scene",
+        "block",
+        "--duration",
+        "5",
+        "--vertical-record",
+        "el-centro-up",
+    ]);
     let out = slidebase(&["run", "--scene", "block", "--alpha", "0.5"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--alpha"));
@@ -90,21 +117,7 @@ fn block_scene_json_has_the_documented_keys() {
 
 #[test]
 fn mass_spring_model_and_outputs() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = slidebase(&[
-        "run",
-        "--model",
-        "mass-spring",
-        "--duration",
-        "3",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let dir = run_with_out(&["run", "--model", "mass-spring", "--duration", "3"]);
     let csv = std::fs::read_to_string(dir.path().join("history.csv")).unwrap();
     assert!(csv.starts_with("time_s,ground_accel_m_s2,slip_m"));
     assert!(csv.lines().count() > 100);

@@ -16,7 +16,7 @@ use slidebase::model::Scene;
 use slidebase::model::presets::resolve_scene;
 use slidebase::model::scene::GroundKind;
 use slidebase::post::sweep::{SweepRow, read_sweep_csv, write_sweep_csv};
-use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
+use slidebase::setup::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, VerticalSpec};
 
 const BLOCK: &str = include_str!("../assets/scenes/block.toml");
 const TWO_BLOCK: &str = include_str!("../assets/scenes/two-block.toml");
@@ -243,13 +243,63 @@ fn dt_with_the_mdof_model_is_refused() {
     assert_has(&e, &["--dt"]);
 }
 
+/// Vertical shaking where it does not apply is refused with the flag and the way out; a
+/// scale out of range names `--vertical-scale`; the scene file's table works as the flag.
+#[test]
+fn vertical_shaking_is_refused_where_it_does_not_apply() {
+    let up = |scale: f64| {
+        Some(VerticalSpec {
+            source: "el-centro-up".into(),
+            scale,
+        })
+    };
+    let e = spec_error(RunSpec {
+        model: ModelKind::MassSpring,
+        vertical: up(1.0),
+        ..RunSpec::default()
+    });
+    assert_has(&e, &["--vertical-record", "--model dda"]);
+    let e = spec_error(RunSpec {
+        ground: Some(GroundKind::LargeMass),
+        vertical: up(1.0),
+        ..RunSpec::scene("block")
+    });
+    assert_has(&e, &["--vertical-record", "--ground prescribed"]);
+    for scale in [0.0, -1.0, f64::NAN, 1e9] {
+        assert_has(
+            &spec_error(RunSpec {
+                vertical: up(scale),
+                ..RunSpec::scene("block")
+            }),
+            &["--vertical-scale"],
+        );
+    }
+    let (code, _, err) = cli(&["run", "--scene", "block", "--vertical-scale", "2"]);
+    assert_ne!(code, 0);
+    assert_has(&err, &["--vertical-record"]);
+    // The scene's [vertical_excitation] is the flag's default.
+    let text = format!("{BLOCK}\n[vertical_excitation]\nrecord = \"el-centro-up\"\nscale = 2.0\n");
+    let scene = Scene::from_toml(&text, "v.toml").unwrap();
+    let from_scene = RunSpec::scene(scene).prepare().unwrap();
+    let from_flag = RunSpec {
+        vertical: up(2.0),
+        ..RunSpec::scene("block")
+    }
+    .prepare()
+    .unwrap();
+    let (a, b) = (from_scene.vertical.unwrap(), from_flag.vertical.unwrap());
+    assert_eq!(a.accel(2.345), b.accel(2.345));
+    let bad = format!("{BLOCK}\n[vertical_excitation]\nrecord = \"el-centro-up\"\nscale = -2.0\n");
+    assert_has(&scene_error(&bad), &["vertical_excitation.scale"]);
+}
+
 #[test]
 fn a_vertical_record_is_not_taken_for_horizontal_input() {
     let e = spec_error(RunSpec {
         excitation: ExcitationSpec::record("el-centro-up"),
         ..RunSpec::default()
     });
-    assert_has(&e, &["el-centro-up", "vertical"]);
+    assert_has(&e, &["el-centro-up", "vertical", "--vertical-record"]);
     let at2 = "PEER\nImperial Valley-02, 5/19/1940, El Centro Array #9, UP\nG\nNPTS= 3, DT= .01 SEC\n0.1 0.2 0.1\n";
     assert!(parse_at2(at2, "u.at2", "u").unwrap().is_vertical());
 }

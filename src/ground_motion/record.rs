@@ -97,8 +97,8 @@ impl Record {
 
     /// Whether the record says it is a vertical component: a `component:` note naming it
     /// up, down or vertical (the shipped CSV files), or a PEER AT2 title line ending in
-    /// `UP`, `DWN` or `V`. slidebase's ground motion is horizontal, so such a record is
-    /// refused as input.
+    /// `UP`, `DWN` or `V`. Such a record is refused as horizontal input (it is the
+    /// vertical excitation's).
     pub fn is_vertical(&self) -> bool {
         self.provenance.split(['\n', '/']).any(|line| {
             let lower = line.trim().to_lowercase();

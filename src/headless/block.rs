@@ -26,6 +26,9 @@ pub struct BlockSummary {
     pub integrator: Option<String>,
     /// Record name (or the harmonic input).
     pub record: String,
+    /// The vertical ground motion (record name), when the ground also shakes vertically.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertical_record: Option<String>,
     /// The joint's friction law as written (`0.15`, `static-kinetic:0.3,0.2`…; absent for
     /// a fixed base).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -104,25 +107,62 @@ pub fn run_block_setup(setup: &RunSetup) -> Result<BlockOutcome> {
     Ok(BlockOutcome { summary, run })
 }
 
-/// Writes a sliding-block run's history, summary and figure into `dir` (all or nothing).
-/// The figure overlays `reference` (the exact rigid block, when the run is DDA's) on the
-/// slip, so that a reader sees at once how far the model is from the textbook block.
+/// Another slip history drawn over a run's in its figure.
+#[derive(Debug, Clone)]
+pub struct SlipOverlay {
+    /// Legend label.
+    pub label: String,
+    /// The run whose slip is drawn.
+    pub run: ModelRun,
+    /// Drawn as markers (a reference the run should match) rather than a line (a variant
+    /// to contrast it with).
+    pub markers: bool,
+}
+
+/// The overlays a teacher wants on a block run's figure: the exact block of the same
+/// inputs (for a DDA run), and the exact block without the vertical shaking (when there
+/// is some), so that its effect shows. Each takes milliseconds.
+pub fn standard_overlays(setup: &RunSetup) -> Result<Vec<SlipOverlay>> {
+    let mut overlays = Vec::new();
+    if setup.model == ModelKind::Dda {
+        overlays.push(SlipOverlay {
+            label: "exact rigid block".into(),
+            run: run_exact_block(setup, setup.dt)?,
+            markers: true,
+        });
+    }
+    if setup.vertical.is_some() {
+        let horizontal_only = RunSetup {
+            vertical: None,
+            ..setup.clone()
+        };
+        overlays.push(SlipOverlay {
+            label: "exact, without vertical shaking".into(),
+            run: run_exact_block(&horizontal_only, setup.dt)?,
+            markers: false,
+        });
+    }
+    Ok(overlays)
+}
+
+/// Writes a sliding-block run's history, summary and figure into `dir` (all or nothing);
+/// the figure draws `overlays` over the run's slip.
 pub fn write_outputs(
     outcome: &BlockOutcome,
-    reference: Option<&ModelRun>,
+    overlays: &[SlipOverlay],
     dir: &std::path::Path,
 ) -> Result<Vec<std::path::PathBuf>> {
     let mut staged = crate::post::output::Staged::new(dir)?;
     outcome.run.history.write_csv(&staged.path("history.csv"))?;
     staged.write_json("summary.json", &outcome.summary)?;
     if !outcome.run.history.is_empty() {
-        history_figure(outcome, reference).save_png(&staged.path("history.png"), 1400, 900)?;
+        history_figure(outcome, overlays).save_png(&staged.path("history.png"), 1400, 900)?;
     }
     staged.commit()
 }
 
-/// The block's acceleration against the ground's, and its slip (with the reference's).
-fn history_figure(outcome: &BlockOutcome, reference: Option<&ModelRun>) -> Figure {
+/// The block's acceleration against the ground's, and its slip (with the overlays').
+fn history_figure(outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
     let s = &outcome.summary;
     let column = |h: &History, name: &str| h.column(name).map(<[f64]>::to_vec).unwrap_or_default();
     let h = &outcome.run.history;
@@ -133,8 +173,15 @@ fn history_figure(outcome: &BlockOutcome, reference: Option<&ModelRun>) -> Figur
             .collect::<Vec<_>>()
     };
     let law = s.friction_law.as_deref().unwrap_or("bonded");
+    let vertical = s
+        .vertical_record
+        .as_ref()
+        .map_or(String::new(), |v| format!(" + vertical {v}"));
     let mut fig = Figure::new(
-        format!("sliding block ({}), friction {law}, {}", s.model, s.record),
+        format!(
+            "sliding block ({}), friction {law}, {}{vertical}",
+            s.model, s.record
+        ),
         2,
         1,
     );
@@ -167,14 +214,20 @@ fn history_figure(outcome: &BlockOutcome, reference: Option<&ModelRun>) -> Figur
     p.y_label = "slip (m)".into();
     p.series
         .push(Series::line(s.model.clone(), t, column(h, "slip_m"), 2));
-    if let Some(r) = reference {
-        // Markers (about 120 of them) so that the two curves stay apart to the eye where
-        // they agree.
-        let (rt, rs) = (column(&r.history, "time_s"), column(&r.history, "slip_m"));
-        let every = (rt.len() / 120).max(1);
-        let pick = |v: Vec<f64>| v.into_iter().step_by(every).collect::<Vec<_>>();
-        p.series
-            .push(Series::markers("exact rigid block", pick(rt), pick(rs), 0));
+    for (k, o) in overlays.iter().enumerate() {
+        let (ot, os) = (
+            column(&o.run.history, "time_s"),
+            column(&o.run.history, "slip_m"),
+        );
+        let color = if k == 0 { 0 } else { 4 };
+        p.series.push(if o.markers {
+            // About 120 markers, so that the curves stay apart to the eye where they agree.
+            let every = (ot.len() / 120).max(1);
+            let pick = |v: Vec<f64>| v.into_iter().step_by(every).collect::<Vec<_>>();
+            Series::markers(o.label.clone(), pick(ot), pick(os), color)
+        } else {
+            Series::line(o.label.clone(), ot, os, color)
+        });
     }
     fig
 }
@@ -187,7 +240,7 @@ pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
         friction: setup.joint_law(),
         gravity: setup.scene.gravity,
         horizontal: &setup.motion,
-        vertical: None,
+        vertical: setup.vertical.as_ref(),
     };
     let output_dt = simulate::exact_output_dt(output_dt, setup.duration);
     let r = simulate_block(&block, setup.duration, output_dt, &BlockOptions::default())?;
@@ -238,6 +291,7 @@ fn summarise(setup: &RunSetup, run: &ModelRun) -> BlockSummary {
         model: setup.model.label().into(),
         integrator: dda.then(|| setup.integrator.label()),
         record: setup.motion.label(),
+        vertical_record: setup.vertical.as_ref().map(|v| v.label()),
         friction_law: friction.map(|_| setup.joint_law().to_string()),
         friction,
         fixed_base: setup.fixed_base,

@@ -110,6 +110,9 @@ pub struct FrameSummary {
     pub integrator: Option<String>,
     /// Record name (or the harmonic input).
     pub record: String,
+    /// The vertical ground motion (record name), when the ground also shakes vertically.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertical_record: Option<String>,
     /// Friction coefficient (absent for a fixed base).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
@@ -241,6 +244,7 @@ fn summarise(
         model: model.label().into(),
         integrator: (model == ModelKind::Dda).then(|| setup.integrator.label()),
         record: setup.motion.label(),
+        vertical_record: setup.vertical.as_ref().map(|v| v.label()),
         friction: super::run::reported_friction(setup, &mut warnings),
         fixed_base: setup.fixed_base,
         duration_s: setup.duration,

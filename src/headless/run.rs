@@ -34,6 +34,9 @@ pub struct RunSummary {
     pub freq_ratio: Option<f64>,
     /// Excitation: `harmonic` or the record name.
     pub excitation: String,
+    /// The vertical ground motion (record name), when the ground also shakes vertically.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertical_record: Option<String>,
     /// Peak ground acceleration, g.
     pub amplitude_g: f64,
     /// Duration, s.
@@ -136,6 +139,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         fixed_base: setup.fixed_base,
         freq_ratio,
         excitation: setup.excitation_label.clone(),
+        vertical_record: setup.vertical.as_ref().map(|v| v.label()),
         amplitude_g: a_max / STANDARD_GRAVITY,
         duration_s: duration,
         dt_s: (!exact).then_some(setup.dt),

@@ -215,6 +215,7 @@ fn building(
         },
         two_block: None,
         sliding_block: None,
+        vertical_excitation: None,
         structure: Some(StructureRoles {
             base: "base-slab".into(),
             floors,

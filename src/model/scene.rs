@@ -51,6 +51,9 @@ pub struct Scene {
     /// The horizontal ground excitation.
     #[serde(default)]
     pub excitation: ExcitationDef,
+    /// The vertical ground excitation, if the ground also shakes vertically.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertical_excitation: Option<VerticalExcitationDef>,
     /// Roles that let the command line re-parameterise a two-mass scene (α, ρ, Ω/ω).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub two_block: Option<TwoBlockRoles>,
@@ -287,6 +290,19 @@ pub enum ExcitationDef {
 
 fn one() -> f64 {
     1.0
+}
+
+/// The vertical ground excitation: a recorded vertical component (up positive), e.g.
+/// `el-centro-up`. It adds to gravity in the frame that moves with the ground, so the
+/// normal force of a joint, and with it its friction capacity, follows N = m(g + a_v).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VerticalExcitationDef {
+    /// Built-in record name (`el-centro-up`…) or an AT2/CSV path.
+    pub record: String,
+    /// Scale factor on the record's accelerations.
+    #[serde(default = "one")]
+    pub scale: f64,
 }
 
 /// Points read strictly: exactly two coordinates (a third would otherwise be dropped

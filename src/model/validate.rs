@@ -590,6 +590,18 @@ fn check_supports(scene: &Scene, names: &HashMap<&str, usize>, ground: usize) ->
 }
 
 fn check_excitation(scene: &Scene) -> Check {
+    if let Some(v) = &scene.vertical_excitation {
+        let at = |key| At::Table("vertical_excitation", Some(key));
+        if v.record.trim().is_empty() {
+            return Err(Issue::new(
+                at("record"),
+                "vertical_excitation.record",
+                "must name a built-in vertical record (el-centro-up) or a file",
+            ));
+        }
+        crate::error::require_range("vertical_excitation.scale", v.scale, 1e-6, 1e3, "")
+            .map_err(|e| Issue::from_error(at("scale"), "", e))?;
+    }
     let at = |key| At::Table("excitation", Some(key));
     match &scene.excitation {
         ExcitationDef::None => Ok(()),

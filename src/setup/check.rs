@@ -158,7 +158,7 @@ fn exact_steps(setup: &RunSetup) -> Option<f64> {
             friction: setup.joint_law(),
             gravity: setup.scene.gravity,
             horizontal: &setup.motion,
-            vertical: None,
+            vertical: setup.vertical.as_ref(),
         };
         return Some(block.steps(setup.duration, &Default::default()));
     }
@@ -206,8 +206,9 @@ pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<Strin
             return Err(Error::invalid(
                 "--record",
                 format!(
-                    "'{}' is a vertical component (its header says so); slidebase shakes \
-                     the ground horizontally: use a horizontal component",
+                    "'{}' is a vertical component (its header says so) and --record is the \
+                     horizontal input: use a horizontal component there, and give this one \
+                     as --vertical-record",
                     r.name
                 ),
             ));
@@ -224,6 +225,9 @@ pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<Strin
                 ),
             ));
         }
+    }
+    if let Some(vertical) = &setup.vertical {
+        check_vertical(setup, vertical, &mut warnings)?;
     }
     match setup.model {
         ModelKind::Dda => {
@@ -247,6 +251,77 @@ pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<Strin
         }
     }
     Ok(warnings)
+}
+
+/// Vertical shaking: where it applies, whether its record is a vertical one, and when it
+/// lifts the structure off the ground.
+fn check_vertical(
+    setup: &RunSetup,
+    vertical: &GroundMotion,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
+    let block = matches!(setup.roles, super::SceneRoles::Block(_));
+    if setup.model == ModelKind::MassSpring && !block {
+        return Err(Error::invalid(
+            "--vertical-record",
+            "the exact mass-spring model of this scene shakes horizontally only; vertical \
+             shaking runs with --model dda (or on --scene block, whose exact model has it)",
+        ));
+    }
+    if setup.scene.ground.kind == crate::model::scene::GroundKind::LargeMass {
+        return Err(Error::invalid(
+            "--vertical-record",
+            "the large-mass ground rides on vertical rollers and is driven horizontally \
+             only; vertical shaking needs --ground prescribed",
+        ));
+    }
+    if let GroundMotion::Record(r) = vertical
+        && !r.is_vertical()
+    {
+        warnings.push(format!(
+            "the vertical record '{}' is not marked as a vertical component (its header \
+             names no UP/DOWN/VERTICAL component); it is used as one",
+            r.name
+        ));
+    }
+    if let Some((t, a)) = first_lift_off(vertical, setup.scene.gravity, setup.duration) {
+        let what = format!(
+            "the vertical ground acceleration reaches {:.3} g downward at t = {t:.3} s, more \
+             than gravity: the structure lifts off the ground there",
+            -a / crate::ground_motion::STANDARD_GRAVITY
+        );
+        if setup.model == ModelKind::MassSpring {
+            return Err(Error::invalid(
+                "--vertical-scale",
+                format!("{what}; the exact sliding block stays on the ground: lower the scale"),
+            ));
+        }
+        warnings.push(format!(
+            "{what}; the joint opens and DDA follows the flight and the landing"
+        ));
+    }
+    Ok(())
+}
+
+/// The first time in [0, duration] when the ground accelerates downward faster than
+/// gravity (g + a_v ≤ 0), and a_v then; records are piecewise linear, so their samples
+/// bound it.
+fn first_lift_off(vertical: &GroundMotion, gravity: f64, duration: f64) -> Option<(f64, f64)> {
+    let times: Vec<f64> = std::iter::once(0.0)
+        .chain(vertical.breakpoints(0.0, duration))
+        .chain(std::iter::once(duration))
+        .collect();
+    times.windows(2).find_map(|w| {
+        let (a0, a1) = (vertical.accel(w[0]), vertical.accel(w[1]));
+        if gravity + a0 <= 0.0 {
+            return Some((w[0], a0));
+        }
+        // Linear in between: where it crosses −g.
+        (gravity + a1 <= 0.0).then(|| {
+            let t = w[0] + (w[1] - w[0]) * (gravity + a0) / (a0 - a1);
+            (t, -gravity)
+        })
+    })
 }
 
 /// Δt against the shortest relevant periods: the excitation's, the two-block structure's

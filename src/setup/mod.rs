@@ -17,4 +17,6 @@ mod spec;
 pub use check::{check_steps, exact_steps_for};
 pub use prepare::{RunSetup, SceneRoles};
 pub use response::{Probe, Response};
-pub use spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneSource};
+pub use spec::{
+    ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneSource, VerticalSpec,
+};

@@ -40,6 +40,8 @@ pub struct RunSetup {
     pub scene: Scene,
     /// The ground motion.
     pub motion: GroundMotion,
+    /// The vertical ground motion (up positive), if the ground also shakes vertically.
+    pub vertical: Option<GroundMotion>,
     /// Duration, s.
     pub duration: f64,
     /// DDA time step, s.
@@ -121,6 +123,7 @@ impl RunSpec {
         if let Some(kind) = self.ground {
             setup.scene.ground.kind = kind;
         }
+        setup.vertical = self.vertical_motion(&setup.scene)?;
         setup.warnings = check::check_setup(&setup, self.confirm_large)?;
         Ok(setup)
     }
@@ -238,6 +241,7 @@ impl RunSpec {
         RunSetup {
             scene,
             motion,
+            vertical: None,
             duration,
             dt: defaults::DT,
             integrator: Integrator::default(),
@@ -278,6 +282,18 @@ impl RunSpec {
             friction,
             label,
         ))
+    }
+
+    /// The vertical ground motion: the specification's, or the scene's.
+    fn vertical_motion(&self, scene: &Scene) -> Result<Option<GroundMotion>> {
+        let (source, scale) = match (&self.vertical, &scene.vertical_excitation) {
+            (Some(v), _) => (v.source.as_str(), v.scale),
+            (None, Some(v)) => (v.record.as_str(), v.scale),
+            (None, None) => return Ok(None),
+        };
+        crate::error::require_range("--vertical-scale", scale, 1e-6, 1e3, "")?;
+        let record = load_record(source, scale)?;
+        Ok(Some(GroundMotion::Record(Arc::new(record))))
     }
 
     /// The ground motion of a building or block scene: the specification's, or the
@@ -434,7 +450,8 @@ impl RunSetup {
     /// The DDA model of `scene` (the run's scene or a variant of it) under the run's
     /// motion, with the blocks it is measured on.
     pub fn build_dda(&self, scene: &Scene, params: SolverParams) -> Result<(Dda, Probe)> {
-        let dda = Dda::new(scene, Some(self.motion.clone()), params)?;
+        let mut dda = Dda::new(scene, Some(self.motion.clone()), params)?;
+        dda.set_vertical_motion(self.vertical.clone())?;
         let probe = Probe {
             base: dda.block_index(&self.base)?,
             roof: dda.block_index(&self.roof)?,

@@ -121,6 +121,15 @@ impl ExcitationSpec {
     }
 }
 
+/// A vertical ground motion: a recorded vertical component (up positive).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerticalSpec {
+    /// Built-in name (`el-centro-up`) or file path.
+    pub source: String,
+    /// Factor on the record's accelerations.
+    pub scale: f64,
+}
+
 /// How much of the time history a run keeps in memory.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum HistoryPlan {
@@ -153,6 +162,8 @@ pub struct RunSpec {
     pub model: ModelKind,
     /// The ground motion.
     pub excitation: ExcitationSpec,
+    /// Vertical ground motion (default: the scene's `[vertical_excitation]`, if any).
+    pub vertical: Option<VerticalSpec>,
     /// Mass ratio α = m/(M + m) (two-block scenes; default: the scene's).
     pub alpha: Option<f64>,
     /// Friction coefficient ρ of the sliding joint (default: the scene's).

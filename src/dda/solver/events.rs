@@ -157,7 +157,9 @@ impl Dda {
             if let Some(s) = self.dofs.slot[bi]
                 && b.role != BlockRole::LargeMassGround
             {
-                forces[s] -= b.total_mass() * self.ground_accel(self.time);
+                let [ax, ay] = self.frame_accel(self.time);
+                forces[s] -= b.total_mass() * ax;
+                forces[s + 1] -= b.total_mass() * ay;
             }
         }
         forces

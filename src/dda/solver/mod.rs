@@ -165,6 +165,8 @@ pub struct Dda {
     connections: Vec<Connection>,
     loads: Vec<PointLoad>,
     motion: Option<GroundMotion>,
+    /// The vertical ground motion (up positive), if the ground also shakes vertically.
+    vertical: Option<GroundMotion>,
     gravity: f64,
     params: SolverParams,
     coeffs: AlphaCoefficients,
@@ -417,6 +419,7 @@ impl Dda {
             connections,
             loads,
             motion,
+            vertical: None,
             gravity: scene.gravity,
             coeffs: params.integrator.coefficients(),
             dt_current: params.dt,
@@ -670,6 +673,40 @@ impl Dda {
     /// Ground acceleration at time t (the input, not the large-mass ground's response).
     pub fn ground_accel(&self, t: f64) -> f64 {
         self.motion.as_ref().map_or(0.0, |m| m.accel(t))
+    }
+
+    /// Vertical ground acceleration at time t, up positive (0 without vertical shaking).
+    pub fn vertical_ground_accel(&self, t: f64) -> f64 {
+        self.vertical.as_ref().map_or(0.0, |m| m.accel(t))
+    }
+
+    /// The ground's acceleration (horizontal, vertical) at time t: in the frame that moves
+    /// with the ground every block feels it, reversed, as a body force per unit mass.
+    fn frame_accel(&self, t: f64) -> [f64; 2] {
+        [self.ground_accel(t), self.vertical_ground_accel(t)]
+    }
+
+    /// Shakes the ground vertically too (`None`: horizontally only), by `motion` (up
+    /// positive). The frame that moves with the ground then accelerates vertically as
+    /// well: every block feels −m·a_v, which adds to its weight, so the normal force of a
+    /// resting block, and its friction capacity, follow N = m(g + a_v). Set it before the
+    /// first step; it is refused for the paper's large-mass ground, which is driven
+    /// horizontally on vertical rollers.
+    pub fn set_vertical_motion(&mut self, motion: Option<GroundMotion>) -> Result<()> {
+        if motion.is_some()
+            && self
+                .blocks
+                .iter()
+                .any(|b| b.role == BlockRole::LargeMassGround)
+        {
+            return Err(Error::invalid(
+                "--ground large-mass",
+                "the large-mass ground rides on vertical rollers and is driven horizontally \
+                 only; vertical shaking needs the prescribed ground (--ground prescribed)",
+            ));
+        }
+        self.vertical = motion;
+        Ok(())
     }
 
     /// Zeroes the strain entries of rigid blocks in a change of the right-hand side.

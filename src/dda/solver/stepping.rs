@@ -450,14 +450,16 @@ impl Dda {
         let centroids = self.centroids();
         let mut external = 0.0;
         let mut input = 0.0;
-        let ground_accel = 0.5 * (self.ground_accel(self.time) + self.ground_accel(t_new));
+        let [ax0, ay0] = self.frame_accel(self.time);
+        let [ax1, ay1] = self.frame_accel(t_new);
+        let ground_accel = [0.5 * (ax0 + ax1), 0.5 * (ay0 + ay1)];
         for (b, d) in self.blocks.iter().zip(increments) {
             if b.role == BlockRole::PrescribedGround {
                 continue;
             }
             external -= b.total_mass() * self.gravity * d[1];
             if b.role != BlockRole::LargeMassGround {
-                input -= b.total_mass() * ground_accel * d[0];
+                input -= b.total_mass() * (ground_accel[0] * d[0] + ground_accel[1] * d[1]);
             }
         }
         for l in &self.loads {

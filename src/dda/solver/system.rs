@@ -75,11 +75,14 @@ impl Dda {
                     let mw: f64 = (0..6).map(|j| b.mass[i][j] * w[j]).sum();
                     sys.r[s + i] -= mw;
                 }
-                // The frame moves with the ground: every block feels −m ü0. The paper's
+                // The frame moves with the ground: every block feels −m ü0 (both
+                // components when the ground also shakes vertically). The paper's
                 // large-mass ground is driven by f = m_g ü0 (eq. 4), which cancels it.
                 if b.role != BlockRole::LargeMassGround {
                     let t_alpha = self.time + (1.0 - c.alpha_f) * dt;
-                    sys.r[s] -= b.total_mass() * self.ground_accel(t_alpha);
+                    let [ax, ay] = self.frame_accel(t_alpha);
+                    sys.r[s] -= b.total_mass() * ax;
+                    sys.r[s + 1] -= b.total_mass() * ay;
                 }
             }
         }
