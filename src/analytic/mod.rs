@@ -14,10 +14,14 @@
 mod exact;
 mod sdof;
 mod sliding_block;
+mod stepped;
 
 pub use exact::{EnergyBalance, ExactOptions, ExactResult, Peaks, Phase, PhaseEvent, simulate};
 pub use sdof::sdof_harmonic_from_rest;
-pub use sliding_block::{BlockEnergy, BlockOptions, BlockResult, SlidingBlock, simulate_block};
+pub use sliding_block::{SlidingBlock, simulate_block};
+pub use stepped::{
+    SlidingStructure, SteppedEnergy, SteppedOptions, SteppedResult, simulate_stepped,
+};
 
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::{Error, Result};

@@ -6,7 +6,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::simulate::{self, ExactEnergy, HISTORY_COLUMNS, ModelRun, Peaks};
-use crate::analytic::{BlockOptions, SlidingBlock, simulate_block};
+use crate::analytic::{SlidingBlock, SteppedOptions, simulate_block};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::history::History;
 use crate::post::plot::{Figure, Series};
@@ -243,11 +243,16 @@ pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
         vertical: setup.vertical.as_ref(),
     };
     let output_dt = simulate::exact_output_dt(output_dt, setup.duration);
-    let r = simulate_block(&block, setup.duration, output_dt, &BlockOptions::default())?;
+    let r = simulate_block(
+        &block,
+        setup.duration,
+        output_dt,
+        &SteppedOptions::default(),
+    )?;
     let mut history = History::new(&HISTORY_COLUMNS);
     for k in 0..r.time.len() {
         let t = r.time[k];
-        let a = r.accel[k];
+        let a = r.raft_accel[k];
         history.push(&[t, setup.motion.accel(t), r.slip[k], 0.0, a, a]);
     }
     let mass = block_mass(setup)?;
@@ -262,8 +267,8 @@ pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
     let peaks = Peaks {
         slip_m: r.max_slip,
         drift_m: 0.0,
-        base_accel: r.peak_accel,
-        roof_accel: r.peak_accel,
+        base_accel: r.peak_raft_accel,
+        roof_accel: r.peak_raft_accel,
         ground_accel: setup.motion.peak_accel(setup.duration),
     };
     Ok(ModelRun::exact(
