@@ -243,7 +243,8 @@ fn dt_with_the_mdof_model_is_refused() {
     assert_has(&e, &["--dt"]);
 }
 
-/// Vertical shaking where it does not apply is refused with the flag and the way out; a
+/// Vertical shaking where it does not apply (the large-mass ground) is refused with the
+/// flag and the way out; a
 /// scale out of range names `--vertical-scale`; the scene file's table works as the flag.
 #[test]
 fn vertical_shaking_is_refused_where_it_does_not_apply() {
@@ -253,12 +254,13 @@ fn vertical_shaking_is_refused_where_it_does_not_apply() {
             scale,
         })
     };
-    let e = spec_error(RunSpec {
+    // The exact model takes it (stepped): not refused.
+    let exact = RunSpec {
         model: ModelKind::MassSpring,
         vertical: up(1.0),
         ..RunSpec::default()
-    });
-    assert_has(&e, &["--vertical-record", "--model dda"]);
+    };
+    assert!(exact.prepare().unwrap().vertical.is_some());
     let e = spec_error(RunSpec {
         ground: Some(GroundKind::LargeMass),
         vertical: up(1.0),
@@ -792,7 +794,7 @@ fn friction_laws_in_a_scene_file_are_parsed_or_refused_with_their_line() {
 /// two-mass parameters set only a Coulomb coefficient, which must not replace it), and
 /// the exact model, which has Coulomb friction only, refuses it by its flag.
 #[test]
-fn a_scene_friction_law_is_kept_by_dda_and_refused_by_the_exact_model() {
+fn a_scene_friction_law_is_kept_by_both_models() {
     use slidebase::model::friction::Friction;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sk.toml");
@@ -810,14 +812,18 @@ fn a_scene_friction_law_is_kept_by_dda_and_refused_by_the_exact_model() {
     let setup = spec(ModelKind::Dda).prepare().unwrap();
     let joint = setup.scene.contacts.iter().find(|c| c.name == setup.joint);
     assert_eq!(joint.unwrap().friction, law.parse::<Friction>().unwrap());
-    assert_has(
-        &spec_error(spec(ModelKind::MassSpring)),
-        &["--model mass-spring", "Coulomb friction only", law],
-    );
-    // --friction states a Coulomb coefficient, which the exact model takes.
+    // The exact model runs it too (stepped: the closed form has Coulomb's only).
+    let exact = spec(ModelKind::MassSpring).prepare().unwrap();
+    assert_eq!(exact.joint_law(), law.parse::<Friction>().unwrap());
+    let summary = run(&spec(ModelKind::MassSpring)).unwrap().summary;
+    assert_eq!(summary.model, "mass-spring");
+    // --friction states a Coulomb coefficient instead.
     let coulomb = RunSpec {
         friction: Some(0.1),
         ..spec(ModelKind::MassSpring)
     };
-    assert!(coulomb.prepare().is_ok());
+    assert_eq!(
+        coulomb.prepare().unwrap().joint_law(),
+        Friction::Coulomb(0.1)
+    );
 }

@@ -99,6 +99,29 @@ impl ShearBuilding {
         (self.raft_mass + self.storey_masses.iter().sum::<f64>()) * self.gravity
     }
 
+    /// This building as a [`SlidingStructure`] for the stepped solution: the joint's law
+    /// `friction` instead of its Coulomb coefficient, the storeys' damping matrix
+    /// `damping` (zeros: undamped), and the ground motions.
+    pub fn sliding_structure<'a>(
+        &self,
+        friction: crate::model::friction::Friction,
+        damping: nalgebra::DMatrix<f64>,
+        horizontal: &'a crate::ground_motion::GroundMotion,
+        vertical: Option<&'a crate::ground_motion::GroundMotion>,
+    ) -> SlidingStructure<'a> {
+        let (_, stiffness) = exact::stick_matrices(self);
+        SlidingStructure {
+            raft_mass: self.raft_mass,
+            storey_masses: self.storey_masses.clone(),
+            stiffness,
+            damping,
+            friction,
+            gravity: self.gravity,
+            horizontal,
+            vertical,
+        }
+    }
+
     /// Fixed-base natural frequencies, Hz, ascending.
     pub fn fixed_base_frequencies_hz(&self) -> Vec<f64> {
         let (m, k) = exact::stick_matrices(self);

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::simulate::{self, ExactEnergy, HISTORY_COLUMNS, ModelRun, Peaks};
+use super::simulate::{self, ModelRun};
 use crate::analytic::{SlidingBlock, SteppedOptions, simulate_block};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::history::History;
@@ -249,36 +249,10 @@ pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
         output_dt,
         &SteppedOptions::default(),
     )?;
-    let mut history = History::new(&HISTORY_COLUMNS);
-    for k in 0..r.time.len() {
-        let t = r.time[k];
-        let a = r.raft_accel[k];
-        history.push(&[t, setup.motion.accel(t), r.slip[k], 0.0, a, a]);
-    }
     let mass = block_mass(setup)?;
-    let e = &r.energy;
-    // Relative to the energy that passed through the block (as the DDA ledger's).
-    let scale = e.input_work.abs().max(e.friction_dissipated + e.kinetic);
-    let energy = ExactEnergy {
-        residual_rel: if scale > 0.0 { e.residual / scale } else { 0.0 },
-        input_work: e.input_work * mass,
-        friction_dissipated: e.friction_dissipated * mass,
-    };
-    let peaks = Peaks {
-        slip_m: r.max_slip,
-        drift_m: 0.0,
-        base_accel: r.peak_raft_accel,
-        roof_accel: r.peak_raft_accel,
-        ground_accel: setup.motion.peak_accel(setup.duration),
-    };
-    Ok(ModelRun::exact(
-        peaks,
-        r.residual_slip,
-        r.steps,
-        energy,
-        history,
-        start,
-    ))
+    let mut run = simulate::stepped_model_run(&r, &setup.motion, true, mass, start);
+    run.peaks.ground_accel = setup.motion.peak_accel(setup.duration);
+    Ok(run)
 }
 
 /// The sliding block's mass per metre of thickness, kg.

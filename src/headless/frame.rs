@@ -487,20 +487,37 @@ fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
         building.friction = f64::INFINITY;
     }
     let motion = &setup.motion;
-    let r = simulate(
-        &building,
-        motion,
-        setup.duration,
-        simulate::exact_output_dt(MDOF_OUTPUT_DT, setup.duration),
-        &ExactOptions::default(),
-    )?;
+    let output_dt = simulate::exact_output_dt(MDOF_OUTPUT_DT, setup.duration);
+    let keep = setup.history.stride() > 0;
+    let (run, raft_accel) = if simulate::needs_stepped(setup) {
+        let n = building.storey_masses.len();
+        let structure = building.sliding_structure(
+            setup.joint_law(),
+            nalgebra::DMatrix::zeros(n, n),
+            motion,
+            setup.vertical.as_ref(),
+        );
+        let options = crate::analytic::SteppedOptions::default();
+        let r = crate::analytic::simulate_stepped(&structure, setup.duration, output_dt, &options)?;
+        let mut run = simulate::stepped_model_run(&r, motion, keep, 1.0, start);
+        run.peaks.ground_accel = motion.peak_accel(setup.duration);
+        (run, (r.time, r.raft_accel))
+    } else {
+        let r = simulate(
+            &building,
+            motion,
+            setup.duration,
+            output_dt,
+            &ExactOptions::default(),
+        )?;
+        let residual = r.energy.residual_relative();
+        let run = simulate::exact_model_run(&r, motion, keep, 1.0, residual, start);
+        (run, (r.time, r.raft_accel))
+    };
     let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
-    for (&t, &a) in r.time.iter().zip(&r.raft_accel) {
+    for (&t, &a) in raft_accel.0.iter().zip(&raft_accel.1) {
         series.push(t, a);
     }
-    let residual = r.energy.residual_relative();
-    let keep = setup.history.stride() > 0;
-    let run = simulate::exact_model_run(&r, motion, keep, 1.0, residual, start);
     let summary = summarise(setup, ModelKind::MassSpring, &run, Some(series))?;
     super::run::check_finite(&summary, setup.duration)?;
     Ok(FrameOutcome {

@@ -193,20 +193,13 @@ pub fn exact_model_run(
     start: Instant,
 ) -> ModelRun {
     let top = r.storey_drift.len().saturating_sub(1);
-    let mut history = History::new(&HISTORY_COLUMNS);
-    if keep_history {
-        for k in 0..r.time.len() {
-            let t = r.time[k];
-            history.push(&[
-                t,
-                motion.accel(t),
-                r.slip[k],
-                r.storey_drift[top][k],
-                r.raft_accel[k],
-                r.storey_accel[top][k],
-            ]);
-        }
-    }
+    let columns = [
+        &r.slip,
+        &r.storey_drift[top],
+        &r.raft_accel,
+        &r.storey_accel[top],
+    ];
+    let history = exact_history(keep_history, &r.time, motion, columns);
     ModelRun::exact(
         Peaks {
             slip_m: r.peaks.slip,
@@ -269,6 +262,67 @@ impl ModelRun {
     }
 }
 
+/// An exact model's outputs as a history ([`HISTORY_COLUMNS`]): slip, roof drift, raft
+/// and roof accelerations at `time` (empty unless `keep`).
+fn exact_history(
+    keep: bool,
+    time: &[f64],
+    motion: &GroundMotion,
+    columns: [&Vec<f64>; 4],
+) -> History {
+    let mut history = History::new(&HISTORY_COLUMNS);
+    if keep {
+        for (k, &t) in time.iter().enumerate() {
+            let [slip, drift, raft, roof] = columns.map(|c| c[k]);
+            history.push(&[t, motion.accel(t), slip, drift, raft, roof]);
+        }
+    }
+    history
+}
+
+/// The stepped mass-spring solution ([`crate::analytic::simulate_stepped`]) as a run,
+/// with (when `keep_history`) its outputs as a history of the top storey. Energies are
+/// multiplied by `energy_scale`.
+pub fn stepped_model_run(
+    r: &crate::analytic::SteppedResult,
+    motion: &GroundMotion,
+    keep_history: bool,
+    energy_scale: f64,
+    start: Instant,
+) -> ModelRun {
+    let columns = [&r.slip, &r.roof_drift, &r.raft_accel, &r.roof_accel];
+    let history = exact_history(keep_history, &r.time, motion, columns);
+    let e = &r.energy;
+    // Relative to the energy that passed through the model (as the DDA ledger's).
+    let scale = e
+        .input_work
+        .abs()
+        .max(e.friction_dissipated + e.damping_dissipated + e.kinetic + e.strain);
+    let energy = ExactEnergy {
+        residual_rel: if scale > 0.0 { e.residual / scale } else { 0.0 },
+        input_work: e.input_work * energy_scale,
+        friction_dissipated: e.friction_dissipated * energy_scale,
+    };
+    let peaks = Peaks {
+        slip_m: r.max_slip,
+        drift_m: r.max_roof_drift,
+        base_accel: r.peak_raft_accel,
+        roof_accel: r.peak_roof_accel,
+        ground_accel: 0.0,
+    };
+    ModelRun::exact(peaks, r.residual_slip, r.steps, energy, history, start)
+}
+
+/// Whether a run of the mass-spring model needs the stepped solution: a friction law
+/// other than Coulomb's, or vertical shaking, which the closed-form propagation does
+/// not have.
+pub fn needs_stepped(setup: &RunSetup) -> bool {
+    !matches!(
+        setup.joint_law(),
+        crate::model::friction::Friction::Coulomb(_)
+    ) || setup.vertical.is_some()
+}
+
 /// The output interval of the exact model: `wanted`, or longer so that a long run keeps
 /// at most [`MAX_HISTORY_ROWS`] rows (0: no output).
 pub fn exact_output_dt(wanted: f64, duration: f64) -> f64 {
@@ -288,13 +342,30 @@ pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun>
             "the exact two-mass model needs a two-block scene",
         )
     })?;
-    run_exact(
-        alpha,
-        roles.structure_frequency_hz,
-        roles.total_mass,
-        setup.friction,
+    let output_dt = exact_output_dt(output_dt, setup.duration);
+    if !needs_stepped(setup) {
+        return run_exact(
+            alpha,
+            roles.structure_frequency_hz,
+            roles.total_mass,
+            setup.friction,
+            &setup.motion,
+            setup.duration,
+            output_dt,
+        );
+    }
+    let start = Instant::now();
+    let building =
+        crate::analytic::ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, 0.0)?;
+    let structure = building.sliding_structure(
+        setup.joint_law(),
+        nalgebra::DMatrix::zeros(1, 1),
         &setup.motion,
-        setup.duration,
-        exact_output_dt(output_dt, setup.duration),
-    )
+        setup.vertical.as_ref(),
+    );
+    let options = crate::analytic::SteppedOptions::default();
+    let r = crate::analytic::simulate_stepped(&structure, setup.duration, output_dt, &options)?;
+    let mut run = stepped_model_run(&r, &setup.motion, true, roles.total_mass, start);
+    run.peaks.ground_accel = setup.motion.peak_accel(setup.duration);
+    Ok(run)
 }

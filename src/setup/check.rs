@@ -151,7 +151,8 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
 }
 
 /// The number of steps the exact model takes: a 32nd of the shortest period of the stick
-/// and slip phases or the excitation, and every record sample.
+/// and slip phases or the excitation (a 1000th for the stepped solution), and every
+/// record sample.
 fn exact_steps(setup: &RunSetup) -> Option<f64> {
     if let super::SceneRoles::Block(_) = setup.roles {
         let block = crate::analytic::SlidingBlock {
@@ -163,6 +164,18 @@ fn exact_steps(setup: &RunSetup) -> Option<f64> {
         return Some(block.steps(setup.duration, &Default::default()));
     }
     let (roles, alpha, _) = setup.two_block()?;
+    if crate::headless::simulate::needs_stepped(setup) {
+        let building =
+            crate::analytic::ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, 0.0)
+                .ok()?;
+        let structure = building.sliding_structure(
+            setup.joint_law(),
+            nalgebra::DMatrix::zeros(1, 1),
+            &setup.motion,
+            setup.vertical.as_ref(),
+        );
+        return Some(structure.steps(setup.duration, &Default::default()));
+    }
     // The slip phase's structure frequency ω/√(1 − α) is the higher one.
     let structure = roles.structure_frequency_hz / (1.0 - alpha).sqrt();
     Some(exact_steps_for(structure, &setup.motion, setup.duration))
@@ -260,14 +273,6 @@ fn check_vertical(
     vertical: &GroundMotion,
     warnings: &mut Vec<String>,
 ) -> Result<()> {
-    let block = matches!(setup.roles, super::SceneRoles::Block(_));
-    if setup.model == ModelKind::MassSpring && !block {
-        return Err(Error::invalid(
-            "--vertical-record",
-            "the exact mass-spring model of this scene shakes horizontally only; vertical \
-             shaking runs with --model dda (or on --scene block, whose exact model has it)",
-        ));
-    }
     if setup.scene.ground.kind == crate::model::scene::GroundKind::LargeMass {
         return Err(Error::invalid(
             "--vertical-record",
@@ -293,7 +298,7 @@ fn check_vertical(
         if setup.model == ModelKind::MassSpring {
             return Err(Error::invalid(
                 "--vertical-scale",
-                format!("{what}; the exact sliding block stays on the ground: lower the scale"),
+                format!("{what}; the mass-spring model stays on the ground: lower the scale"),
             ));
         }
         warnings.push(format!(

@@ -134,7 +134,7 @@ impl RunSpec {
             Some(a) => a,
             None => scene_alpha(&scene, &roles)?,
         };
-        let law = self.joint_law(&scene, &roles.joint)?;
+        let law = self.run_law(&scene, &roles.joint);
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
@@ -269,7 +269,7 @@ impl RunSpec {
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
-            self.joint_law(&scene, &roles.joint)?.sticking_coefficient()
+            self.run_law(&scene, &roles.joint).sticking_coefficient()
         };
         let roof = roles.floors.last().unwrap_or(&roles.base).clone();
         let blocks = [roles.base.clone(), roof, roles.joint.clone()];
@@ -369,7 +369,6 @@ impl RunSpec {
             set_joint_law(&mut scene, &roles.joint, law);
         }
         let motion = self.scene_or_given_motion(&scene)?;
-        // The block's exact model has every law: no refusal for `--model mass-spring`.
         let friction = if self.fixed_base {
             f64::INFINITY
         } else {
@@ -411,28 +410,6 @@ impl RunSpec {
                 .find(|c| c.name == joint)
                 .map_or(Friction::Coulomb(0.0), |c| c.friction),
         }
-    }
-
-    /// The friction law of the named joint as the run will have it (`--friction` replaces
-    /// the scene's law by Coulomb's), refused for the exact mass-spring model unless it is
-    /// Coulomb's: that model has no other law, and running it with the sticking
-    /// coefficient alone would compare different physics without a word.
-    fn joint_law(&self, scene: &Scene, joint: &str) -> Result<Friction> {
-        let law = self.run_law(scene, joint);
-        if self.model == ModelKind::MassSpring
-            && !self.fixed_base
-            && !matches!(law, Friction::Coulomb(_))
-        {
-            return Err(Error::invalid(
-                "--model mass-spring",
-                format!(
-                    "the exact mass-spring model has Coulomb friction only, and the joint \
-                     '{joint}' has '{law}'; use --model dda, or --friction to set a Coulomb \
-                     coefficient"
-                ),
-            ));
-        }
-        Ok(law)
     }
 }
 
