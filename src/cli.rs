@@ -129,6 +129,10 @@ struct RunArgs {
     /// Factor on the vertical record's accelerations (default 1).
     #[arg(long, requires = "vertical_record", allow_hyphen_values = true)]
     vertical_scale: Option<f64>,
+    /// Structural damping ratio ζ, e.g. 0.05 (two-block scenes: a dashpot c = 2ζ√(k m)
+    /// beside the spring, in DDA and the exact model alike; sliding is never damped).
+    #[arg(long, allow_hyphen_values = true)]
+    damping: Option<f64>,
     /// Ground model of the DDA run (default: the scene's).
     #[arg(long, value_enum)]
     ground: Option<GroundArg>,
@@ -400,6 +404,7 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
         friction: args.friction,
         friction_law: args.friction_law,
         fixed_base: args.fixed_base,
+        damping: args.damping,
         pga_g: None,
         ground: args.ground.map(|g| match g {
             GroundArg::Prescribed => GroundKind::Prescribed,

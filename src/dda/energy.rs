@@ -21,6 +21,8 @@ pub struct EnergyTerms {
     pub friction_dissipated: f64,
     /// Energy dissipated by the contact dashpots (relative motion across closed joints).
     pub contact_damping: f64,
+    /// Energy dissipated by the structure's own damping (the bolts' dashpots).
+    pub structural_damping: f64,
     /// Energy lost in impacts: contacts that close are taken as plastic impacts (the
     /// hitting vertex's approach velocity is removed within the step), and the energy the
     /// impact steps remove is counted here rather than as numerical dissipation.
@@ -41,6 +43,7 @@ impl EnergyTerms {
             - self.strain
             - self.friction_dissipated
             - self.contact_damping
+            - self.structural_damping
             - self.impact_dissipated
             - self.numerical_dissipated
     }
@@ -53,6 +56,7 @@ impl EnergyTerms {
                 + self.strain.abs()
                 + self.friction_dissipated.abs()
                 + self.contact_damping.abs()
+                + self.structural_damping.abs()
                 + self.impact_dissipated.abs()
                 + self.numerical_dissipated.abs(),
         )

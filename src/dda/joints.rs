@@ -89,6 +89,8 @@ pub struct Bolt {
     pub stiffness: f64,
     /// Two-component or axial.
     pub kind: BoltKind,
+    /// Dashpot in parallel with the spring, N·s/m (0: none).
+    pub damping: f64,
 }
 
 impl Bolt {
@@ -160,6 +162,22 @@ impl Bolt {
         };
         pattern(&mut terms.ke, s);
         terms
+    }
+
+    /// The directions the dashpot acts along: x and y for a two-component bolt, the axis
+    /// (from P to Q) for an axial one; none without a dashpot.
+    pub fn dashpot_directions(&self) -> smallvec::SmallVec<[Point; 2]> {
+        if self.damping == 0.0 {
+            return smallvec::SmallVec::new();
+        }
+        match self.kind {
+            BoltKind::TwoComponent => smallvec::smallvec![[1.0, 0.0], [0.0, 1.0]],
+            BoltKind::Axial => {
+                let d = sub(self.points[1], self.points[0]);
+                let l = d[0].hypot(d[1]).max(f64::MIN_POSITIVE);
+                smallvec::smallvec![[d[0] / l, d[1] / l]]
+            }
+        }
     }
 
     /// Stored energy, J.

@@ -314,13 +314,14 @@ pub fn stepped_model_run(
 }
 
 /// Whether a run of the mass-spring model needs the stepped solution: a friction law
-/// other than Coulomb's, or vertical shaking, which the closed-form propagation does
-/// not have.
+/// other than Coulomb's, vertical shaking or damping, which the closed-form propagation
+/// does not have.
 pub fn needs_stepped(setup: &RunSetup) -> bool {
     !matches!(
         setup.joint_law(),
         crate::model::friction::Friction::Coulomb(_)
     ) || setup.vertical.is_some()
+        || setup.damping_ratio > 0.0
 }
 
 /// The output interval of the exact model: `wanted`, or longer so that a long run keeps
@@ -357,9 +358,12 @@ pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun>
     let start = Instant::now();
     let building =
         crate::analytic::ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, 0.0)?;
+    // c = 2ζ√(k m) = 2ζ·m·ω on the unit-mass model (m = α).
+    let omega = 2.0 * std::f64::consts::PI * roles.structure_frequency_hz;
+    let damping = 2.0 * setup.damping_ratio * alpha * omega;
     let structure = building.sliding_structure(
         setup.joint_law(),
-        nalgebra::DMatrix::zeros(1, 1),
+        nalgebra::DMatrix::from_element(1, 1, damping),
         &setup.motion,
         setup.vertical.as_ref(),
     );

@@ -197,6 +197,14 @@ pub struct BoltDef {
     /// Two-component (paper) or axial.
     #[serde(default)]
     pub kind: BoltKind,
+    /// A dashpot in parallel with the spring, on the relative velocity of the two points
+    /// (both components, or along the axis for an axial bolt), N·s/m (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub damping: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// A node of a connection element: a point carried by a block.

@@ -519,6 +519,14 @@ fn check_bolts(scene: &Scene, names: &HashMap<&str, usize>) -> Check {
             &format!("{label} stiffness"),
             bolt.stiffness,
         )?;
+        crate::error::require_range(
+            &format!("{label} damping"),
+            bolt.damping,
+            0.0,
+            1e15,
+            "N·s/m",
+        )
+        .map_err(|e| Issue::from_error(at("damping"), "", e))?;
     }
     Ok(())
 }

@@ -110,6 +110,20 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
             }
         }
     }
+    if let Some(zeta) = spec.damping {
+        crate::error::require_range("--damping", zeta, 0.0, 0.99, "(the damping ratio ζ)")?;
+        if scene.two_block.is_none() {
+            return Err(Error::invalid(
+                "--damping",
+                format!(
+                    "structural damping is built for two-block scenes (a dashpot beside \
+                     the structure's spring); '{}' is not one, and the Rayleigh damping of \
+                     building scenes is not there yet",
+                    scene.name
+                ),
+            ));
+        }
+    }
     if spec.fixed_base && spec.friction.is_some() {
         return Err(Error::invalid(
             "--friction",

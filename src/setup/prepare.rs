@@ -64,6 +64,8 @@ pub struct RunSetup {
     pub friction: f64,
     /// Whether the joint is bonded.
     pub fixed_base: bool,
+    /// Structural damping ratio ζ (0: undamped).
+    pub damping_ratio: f64,
     /// `harmonic` or the record's name.
     pub excitation_label: String,
     /// Factor applied to the ground motion to reach [`RunSpec::pga_g`] (1: as given).
@@ -193,6 +195,9 @@ impl RunSpec {
         };
         params.validate()?;
         apply_two_block(&mut scene, &params)?;
+        if let Some(zeta) = self.damping {
+            set_structure_damping(&mut scene, &roles, alpha, zeta);
+        }
         if !self.fixed_base {
             // The two-mass parameters set a Coulomb coefficient; the run's law is the one.
             set_joint_law(&mut scene, &roles.joint, law);
@@ -253,6 +258,7 @@ impl RunSpec {
             joint,
             friction,
             fixed_base: self.fixed_base,
+            damping_ratio: self.damping.unwrap_or(0.0),
             excitation_label,
             motion_scale: 1.0,
             warnings: Vec::new(),
@@ -493,6 +499,16 @@ fn scene_alpha(scene: &Scene, roles: &TwoBlockRoles) -> Result<f64> {
     };
     let (m, big_m) = (mass(&roles.roof)?, mass(&roles.raft)?);
     Ok(m / (m + big_m))
+}
+
+/// A dashpot c = 2ζ√(k m) = 2ζ·m·ω in parallel with a two-block scene's spring (its
+/// parameters already applied).
+fn set_structure_damping(scene: &mut Scene, roles: &TwoBlockRoles, alpha: f64, zeta: f64) {
+    let m = alpha * roles.total_mass;
+    let omega = 2.0 * std::f64::consts::PI * roles.structure_frequency_hz;
+    for b in scene.bolts.iter_mut().filter(|b| b.name == roles.spring) {
+        b.damping = 2.0 * zeta * m * omega;
+    }
 }
 
 /// Gives the named joint the friction law `law`.

@@ -172,6 +172,9 @@ pub struct RunSpec {
     pub friction_law: Option<Friction>,
     /// Fix the base: the sliding joint is bonded and never slides.
     pub fixed_base: bool,
+    /// Structural damping ratio ζ (two-block scenes: a dashpot c = 2ζ√(k m) in parallel
+    /// with the structure's spring, in DDA and in the exact model alike; default 0).
+    pub damping: Option<f64>,
     /// Scale the ground motion to this peak ground acceleration over the run, g (default:
     /// as given).
     pub pga_g: Option<f64>,

@@ -2,6 +2,8 @@
 //! `mod common;`).
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
+// Each test crate that declares `mod common;` uses a subset of these helpers.
+#![allow(dead_code)]
 
 use slidebase::model::Scene;
 
@@ -56,4 +58,29 @@ friction = {friction}
         v3 = fmt(v[3]),
     );
     Scene::from_toml(&text, "incline").unwrap()
+}
+
+/// Runs a two-block specification with DDA and with the exact model and checks the
+/// paper's four metrics agree within `tolerance` (relative); `label` names the case.
+pub fn assert_two_block_models_agree(
+    spec: impl Fn(slidebase::setup::ModelKind) -> slidebase::setup::RunSpec,
+    tolerance: f64,
+    label: &str,
+) {
+    use slidebase::headless::run::run;
+    use slidebase::setup::ModelKind;
+    let dda = run(&spec(ModelKind::Dda)).unwrap().summary;
+    let exact = run(&spec(ModelKind::MassSpring)).unwrap().summary;
+    for (what, d, e) in [
+        ("u_s", dda.us_max_over_d, exact.us_max_over_d),
+        ("u_r", dda.ur_max_over_d, exact.ur_max_over_d),
+        ("a_base", dda.abase_over_aground, exact.abase_over_aground),
+        ("a_roof", dda.aroof_over_aground, exact.aroof_over_aground),
+    ] {
+        let (d, e) = (d.unwrap(), e.unwrap());
+        assert!(
+            (d / e - 1.0).abs() < tolerance,
+            "{label}, {what}: DDA {d}, exact {e}"
+        );
+    }
 }

@@ -364,6 +364,7 @@ impl Dda {
                 rest: geometry::sub(b.points[1], b.points[0]),
                 stiffness: b.stiffness,
                 kind: b.kind,
+                damping: b.damping,
             });
         }
         let mut connections = Vec::new();

@@ -444,6 +444,14 @@ impl Dda {
                 damped += force * (dot6(a, &increments[i]) + dot6(b, &increments[j]));
             }
         }
+        // The structure's dashpots (bolts), the same way, booked apart from the joints'.
+        let mut structural = 0.0;
+        for (damping, i, a, j, b) in self.bolt_dashpot_rows() {
+            let q0 = self.directional_velocity(i, &a, j, &b, &|k| start[k][0]);
+            let q1 = self.directional_velocity(i, &a, j, &b, &|k| self.blocks[k].velocity);
+            let force = damping * ((1.0 - c.alpha_f) * q1 + c.alpha_f * q0);
+            structural += force * (dot6(&a, &increments[i]) + dot6(&b, &increments[j]));
+        }
         // Work of the loads: gravity and point loads, and the ground's acceleration, which
         // in the frame moving with the ground is a body force −m ü0 on every block (but
         // the paper's large-mass ground, whose driving force m_g ü0 cancels it).
@@ -494,6 +502,7 @@ impl Dda {
         e.external_work += external;
         e.friction_dissipated += dissipated;
         e.contact_damping += damped;
+        e.structural_damping += structural;
         if impact {
             // A plastic impact step (penalty contacts): what the scheme removed is the
             // impact's loss.

@@ -90,6 +90,11 @@ impl Dda {
         for e in elements {
             sys.add_nodal_element(&self.dofs, known, &centroids, e);
         }
+        if let Mode::Dynamic { dt } = mode {
+            for (damping, i, a, j, b) in self.bolt_dashpot_rows() {
+                self.add_dashpot(sys, damping, (i, &a), (j, &b), dt);
+            }
+        }
         for l in &self.loads {
             if let Some(s) = self.dofs.slot[l.block] {
                 let f = t_transpose_times(centroids[l.block], l.point, l.force);
@@ -183,41 +188,69 @@ impl Dda {
         dot6(a, &vel(i)) + dot6(b, &vel(j))
     }
 
-    /// Adds the dashpots of a closed contact: force c·q̇ at the generalised-α point, with
-    /// q̇ of a free block from the Newmark velocity update (linear in the increment) and of
-    /// the prescribed ground from its motion.
+    /// Adds the dashpots of a closed contact (see [`Dda::add_dashpot`]).
     pub(super) fn add_dashpots(&self, sys: &mut System, c: &Contact, dt: f64) {
         let (cn, cs) = self.dashpot_coefficients(c);
-        let co = &self.coeffs;
         let (i, j) = (c.key.vertex_block, c.key.edge_block);
         for (damping, a, b) in [(cn, &c.gap_i, &c.gap_j), (cs, &c.slip_i, &c.slip_j)] {
-            if damping == 0.0 {
-                continue;
+            self.add_dashpot(sys, damping, (i, a), (j, b), dt);
+        }
+    }
+
+    /// The bolts' dashpots, one row per direction: (coefficient, block i and the map of
+    /// its unknowns to the relative velocity, block j and its map). The relative velocity
+    /// q = e·(v_Q − v_P) of the bolt's ends along direction e, at the step start.
+    pub(super) fn bolt_dashpot_rows(&self) -> Vec<(f64, usize, Vec6, usize, Vec6)> {
+        let centroids = self.centroids();
+        let mut rows = Vec::new();
+        for bolt in &self.bolts {
+            let [i, j] = bolt.blocks;
+            for e in bolt.dashpot_directions() {
+                let a = t_transpose_times(centroids[i], bolt.points[0], [-e[0], -e[1]]);
+                let b = t_transpose_times(centroids[j], bolt.points[1], e);
+                rows.push((bolt.damping, i, a, j, b));
             }
-            // v_{n+1} = γ/(βΔt)·D + w.
-            let mut f0 = 0.0;
-            let mut parts: Vec<(usize, &Vec6)> = Vec::with_capacity(2);
-            for (blk, vec) in [(i, a), (j, b)] {
-                let bl = &self.blocks[blk];
-                // The prescribed ground (no unknowns) stands still in the moving frame.
-                if self.dofs.slot[blk].is_some() {
-                    let mut w = [0.0; 6];
-                    for k in 0..6 {
-                        w[k] = co.velocity_predictor(bl.velocity[k], bl.accel[k], dt);
-                    }
-                    f0 += damping
-                        * ((1.0 - co.alpha_f) * dot6(vec, &w)
-                            + co.alpha_f * dot6(vec, &bl.velocity));
-                    parts.push((blk, vec));
+        }
+        rows
+    }
+
+    /// Adds a dashpot of coefficient `damping` on the relative velocity q = a·v_i + b·v_j:
+    /// force c·q at the generalised-α point, with the velocity of a free block from the
+    /// Newmark update (linear in the increment) and that of the prescribed ground (which
+    /// stands still in the moving frame) zero.
+    pub(super) fn add_dashpot(
+        &self,
+        sys: &mut System,
+        damping: f64,
+        (i, a): (usize, &Vec6),
+        (j, b): (usize, &Vec6),
+        dt: f64,
+    ) {
+        if damping == 0.0 {
+            return;
+        }
+        let co = &self.coeffs;
+        // v_{n+1} = γ/(βΔt)·D + w.
+        let mut f0 = 0.0;
+        let mut parts: SmallVec<[(usize, &Vec6); 2]> = SmallVec::new();
+        for (blk, vec) in [(i, a), (j, b)] {
+            let bl = &self.blocks[blk];
+            if self.dofs.slot[blk].is_some() {
+                let mut w = [0.0; 6];
+                for k in 0..6 {
+                    w[k] = co.velocity_predictor(bl.velocity[k], bl.accel[k], dt);
                 }
+                f0 += damping
+                    * ((1.0 - co.alpha_f) * dot6(vec, &w) + co.alpha_f * dot6(vec, &bl.velocity));
+                parts.push((blk, vec));
             }
-            let k = damping * co.gamma / (co.beta * dt);
-            match parts.as_slice() {
-                [] => {}
-                [p] => sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), None),
-                [p, q, ..] => {
-                    sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), Some((q.0, q.1)))
-                }
+        }
+        let k = damping * co.gamma / (co.beta * dt);
+        match parts.as_slice() {
+            [] => {}
+            [p] => sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), None),
+            [p, q, ..] => {
+                sys.add_scalar_spring(&self.dofs, &[], k, f0, (p.0, p.1), Some((q.0, q.1)))
             }
         }
     }
