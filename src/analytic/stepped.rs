@@ -227,7 +227,7 @@ impl<'a, 'b> Stepper<'a, 'b> {
     fn solve(&mut self, duration: f64) -> Result<()> {
         self.check_normal(0.0)?;
         self.set_phase(0.0, Phase::Stick);
-        if let Some(d) = self.breakaway(0.0, &self.y.clone()) {
+        if let Some(d) = self.breakaway(0.0, &self.y) {
             self.set_phase(0.0, Phase::Slip { direction: d });
         }
         self.observe();
@@ -348,10 +348,12 @@ impl<'a, 'b> Stepper<'a, 'b> {
         let stop = bisect(t0, end, self.options.root_tolerance, |t| !moving(t));
         let mut y = self.rk4(t0, &y0, stop - t0, Some(d));
         self.t = stop;
-        self.observe_peaks(&y, Some(d));
+        let m = self.measure(&y, Some(d));
+        self.record_peaks(&m);
         y[1] = 0.0;
+        let next = self.breakaway(stop, &y);
         self.y = y;
-        match self.breakaway(stop, &self.y.clone()) {
+        match next {
             // Still driven past the sticking limit: it slides back the other way.
             Some(nd) => self.set_phase(stop, Phase::Slip { direction: nd }),
             None => self.set_phase(stop, Phase::Stick),
@@ -396,11 +398,13 @@ impl<'a, 'b> Stepper<'a, 'b> {
         let ku = &self.st.stiffness * &u;
         let cdu = &self.st.damping * &du;
         let base_shear = ku.sum() + cdu.sum();
-        let s_acc = match slip {
-            None => 0.0,
+        // The raft's slip acceleration and the friction's power, both zero while stuck.
+        let (s_acc, friction_power) = match slip {
+            None => (0.0, 0.0),
             Some(d) => {
                 let friction = self.friction_force(t, v);
-                (base_shear - friction * d) / self.st.raft_mass - a_g
+                let s_acc = (base_shear - friction * d) / self.st.raft_mass - a_g;
+                (s_acc, friction * v * d)
             }
         };
         let mut dy = DVector::zeros(y.len());
@@ -421,7 +425,7 @@ impl<'a, 'b> Stepper<'a, 'b> {
                 .map(|(m, w)| m * w)
                 .sum::<f64>();
         dy[k] = -a_g * momentum;
-        dy[k + 1] = slip.map_or(0.0, |d| self.friction_force(t, v) * v * d);
+        dy[k + 1] = friction_power;
         dy[k + 2] = du.dot(&cdu);
         dy
     }
@@ -477,38 +481,51 @@ impl<'a, 'b> Stepper<'a, 'b> {
             Phase::Stick => None,
             Phase::Slip { direction } => Some(direction),
         };
-        let y = self.y.clone();
-        let (raft, roof) = self.observe_peaks(&y, slip);
+        let m = self.measure(&self.y, slip);
+        self.record_peaks(&m);
         if self.output_dt > 0.0 && self.t >= self.next_output - 1e-12 {
-            let drift = if self.n > 0 { y[1 + self.n] } else { 0.0 };
             let r = &mut self.result;
             r.time.push(self.t);
-            r.slip.push(y[0]);
-            r.roof_drift.push(drift);
-            r.raft_accel.push(raft);
-            r.roof_accel.push(roof);
+            r.slip.push(m.slip);
+            r.roof_drift.push(m.drift);
+            r.raft_accel.push(m.raft_accel);
+            r.roof_accel.push(m.roof_accel);
             self.next_output += self.output_dt;
         }
     }
 
-    /// Updates the peaks with the state `y` at the current time; returns the raft's and
-    /// the top storey's absolute accelerations.
-    fn observe_peaks(&mut self, y: &State, slip: Option<f64>) -> (f64, f64) {
+    /// The reported quantities of state `y` at the current time.
+    fn measure(&self, y: &State, slip: Option<f64>) -> Measured {
         let dy = self.rate(self.t, y, slip);
-        let a_g = self.st.horizontal.accel(self.t);
-        let raft = a_g + dy[1];
-        let (roof, drift) = if self.n > 0 {
-            (raft + dy[1 + 2 * self.n], y[1 + self.n])
+        let raft_accel = self.st.horizontal.accel(self.t) + dy[1];
+        let (roof_accel, drift) = if self.n > 0 {
+            (raft_accel + dy[1 + 2 * self.n], y[1 + self.n])
         } else {
-            (raft, 0.0)
+            (raft_accel, 0.0)
         };
-        let r = &mut self.result;
-        r.max_slip = r.max_slip.max(y[0].abs());
-        r.max_roof_drift = r.max_roof_drift.max(drift.abs());
-        r.peak_raft_accel = r.peak_raft_accel.max(raft.abs());
-        r.peak_roof_accel = r.peak_roof_accel.max(roof.abs());
-        (raft, roof)
+        Measured {
+            slip: y[0],
+            drift,
+            raft_accel,
+            roof_accel,
+        }
     }
+
+    fn record_peaks(&mut self, m: &Measured) {
+        let r = &mut self.result;
+        r.max_slip = r.max_slip.max(m.slip.abs());
+        r.max_roof_drift = r.max_roof_drift.max(m.drift.abs());
+        r.peak_raft_accel = r.peak_raft_accel.max(m.raft_accel.abs());
+        r.peak_roof_accel = r.peak_roof_accel.max(m.roof_accel.abs());
+    }
+}
+
+/// The quantities a run reports at one instant.
+struct Measured {
+    slip: f64,
+    drift: f64,
+    raft_accel: f64,
+    roof_accel: f64,
 }
 
 /// The step length: the options' longest step, shortened to resolve the slip phase's
@@ -546,7 +563,7 @@ fn step_length(st: &SlidingStructure, options: &SteppedOptions) -> f64 {
 
 /// The first time in (lo, hi] at which `event` holds, given that it does not at `lo` and
 /// does at `hi`, to within `tol`.
-pub(super) fn bisect(mut lo: f64, mut hi: f64, tol: f64, event: impl Fn(f64) -> bool) -> f64 {
+fn bisect(mut lo: f64, mut hi: f64, tol: f64, event: impl Fn(f64) -> bool) -> f64 {
     while hi - lo > tol {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {

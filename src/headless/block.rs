@@ -6,7 +6,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::simulate::{self, ModelRun};
-use crate::analytic::{SlidingBlock, SteppedOptions, simulate_block};
+use crate::analytic::{SteppedOptions, simulate_block};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::history::History;
 use crate::post::plot::{Figure, Series};
@@ -236,29 +236,19 @@ fn history_figure(outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
 /// seconds, none if ≤ 0). Energies per unit mass are scaled by the DDA block's mass.
 pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
     let start = Instant::now();
-    let block = SlidingBlock {
-        friction: setup.joint_law(),
-        gravity: setup.scene.gravity,
-        horizontal: &setup.motion,
-        vertical: setup.vertical.as_ref(),
-    };
     let output_dt = simulate::exact_output_dt(output_dt, setup.duration);
-    let r = simulate_block(
-        &block,
-        setup.duration,
-        output_dt,
-        &SteppedOptions::default(),
-    )?;
-    let mass = block_mass(setup)?;
-    let mut run = simulate::stepped_model_run(&r, &setup.motion, true, mass, start);
-    run.peaks.ground_accel = setup.motion.peak_accel(setup.duration);
-    Ok(run)
-}
-
-/// The sliding block's mass per metre of thickness, kg.
-fn block_mass(setup: &RunSetup) -> Result<f64> {
-    let b = &setup.scene.blocks[setup.scene.block_index(&setup.base)?];
-    Ok(b.material.density * crate::model::geometry::moments(&b.vertices, &b.name)?.area)
+    let options = SteppedOptions::default();
+    let r = simulate_block(&setup.sliding_block(), setup.duration, output_dt, &options)?;
+    let mass = setup.scene.block_mass(&setup.base)?;
+    let duration = setup.duration;
+    Ok(simulate::stepped_model_run(
+        &r,
+        &setup.motion,
+        duration,
+        true,
+        mass,
+        start,
+    ))
 }
 
 fn summarise(setup: &RunSetup, run: &ModelRun) -> BlockSummary {

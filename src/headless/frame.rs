@@ -489,7 +489,7 @@ fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
     let motion = &setup.motion;
     let output_dt = simulate::exact_output_dt(MDOF_OUTPUT_DT, setup.duration);
     let keep = setup.history.stride() > 0;
-    let (run, raft_accel) = if simulate::needs_stepped(setup) {
+    let (run, raft_accel) = if setup.needs_stepped_exact() {
         let n = building.storey_masses.len();
         let structure = building.sliding_structure(
             setup.joint_law(),
@@ -499,8 +499,7 @@ fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
         );
         let options = crate::analytic::SteppedOptions::default();
         let r = crate::analytic::simulate_stepped(&structure, setup.duration, output_dt, &options)?;
-        let mut run = simulate::stepped_model_run(&r, motion, keep, 1.0, start);
-        run.peaks.ground_accel = motion.peak_accel(setup.duration);
+        let run = simulate::stepped_model_run(&r, motion, setup.duration, keep, 1.0, start);
         (run, (r.time, r.raft_accel))
     } else {
         let r = simulate(

@@ -280,12 +280,13 @@ fn exact_history(
     history
 }
 
-/// The stepped mass-spring solution ([`crate::analytic::simulate_stepped`]) as a run,
-/// with (when `keep_history`) its outputs as a history of the top storey. Energies are
-/// multiplied by `energy_scale`.
+/// The stepped mass-spring solution ([`crate::analytic::simulate_stepped`]) of a run
+/// `duration` seconds long, as a run, with (when `keep_history`) its outputs as a history
+/// of the top storey. Energies are multiplied by `energy_scale`.
 pub fn stepped_model_run(
     r: &crate::analytic::SteppedResult,
     motion: &GroundMotion,
+    duration: f64,
     keep_history: bool,
     energy_scale: f64,
     start: Instant,
@@ -308,20 +309,9 @@ pub fn stepped_model_run(
         drift_m: r.max_roof_drift,
         base_accel: r.peak_raft_accel,
         roof_accel: r.peak_roof_accel,
-        ground_accel: 0.0,
+        ground_accel: motion.peak_accel(duration),
     };
     ModelRun::exact(peaks, r.residual_slip, r.steps, energy, history, start)
-}
-
-/// Whether a run of the mass-spring model needs the stepped solution: a friction law
-/// other than Coulomb's, vertical shaking or damping, which the closed-form propagation
-/// does not have.
-pub fn needs_stepped(setup: &RunSetup) -> bool {
-    !matches!(
-        setup.joint_law(),
-        crate::model::friction::Friction::Coulomb(_)
-    ) || setup.vertical.is_some()
-        || setup.damping_ratio > 0.0
 }
 
 /// The output interval of the exact model: `wanted`, or longer so that a long run keeps
@@ -344,7 +334,10 @@ pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun>
         )
     })?;
     let output_dt = exact_output_dt(output_dt, setup.duration);
-    if !needs_stepped(setup) {
+    let Some(structure) = setup
+        .two_block_structure()
+        .filter(|_| setup.needs_stepped_exact())
+    else {
         return run_exact(
             alpha,
             roles.structure_frequency_hz,
@@ -354,22 +347,17 @@ pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun>
             setup.duration,
             output_dt,
         );
-    }
+    };
     let start = Instant::now();
-    let building =
-        crate::analytic::ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, 0.0)?;
-    // c = 2ζ√(k m) = 2ζ·m·ω on the unit-mass model (m = α).
-    let omega = 2.0 * std::f64::consts::PI * roles.structure_frequency_hz;
-    let damping = 2.0 * setup.damping_ratio * alpha * omega;
-    let structure = building.sliding_structure(
-        setup.joint_law(),
-        nalgebra::DMatrix::from_element(1, 1, damping),
-        &setup.motion,
-        setup.vertical.as_ref(),
-    );
     let options = crate::analytic::SteppedOptions::default();
-    let r = crate::analytic::simulate_stepped(&structure, setup.duration, output_dt, &options)?;
-    let mut run = stepped_model_run(&r, &setup.motion, true, roles.total_mass, start);
-    run.peaks.ground_accel = setup.motion.peak_accel(setup.duration);
-    Ok(run)
+    let r = crate::analytic::simulate_stepped(&structure?, setup.duration, output_dt, &options)?;
+    let duration = setup.duration;
+    Ok(stepped_model_run(
+        &r,
+        &setup.motion,
+        duration,
+        true,
+        roles.total_mass,
+        start,
+    ))
 }

@@ -407,6 +407,12 @@ impl Scene {
         toml::to_string(self).map_err(|e| Error::Scene(format!("cannot serialise scene: {e}")))
     }
 
+    /// Mass of the named block as written (density × area), kg per metre of thickness.
+    pub fn block_mass(&self, name: &str) -> Result<f64> {
+        let b = &self.blocks[self.block_index(name)?];
+        Ok(b.material.density * super::geometry::moments(&b.vertices, &b.name)?.area)
+    }
+
     /// Index of the block with this name.
     pub fn block_index(&self, name: &str) -> Result<usize> {
         self.blocks

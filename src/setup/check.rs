@@ -169,25 +169,15 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
 /// record sample.
 fn exact_steps(setup: &RunSetup) -> Option<f64> {
     if let super::SceneRoles::Block(_) = setup.roles {
-        let block = crate::analytic::SlidingBlock {
-            friction: setup.joint_law(),
-            gravity: setup.scene.gravity,
-            horizontal: &setup.motion,
-            vertical: setup.vertical.as_ref(),
-        };
-        return Some(block.steps(setup.duration, &Default::default()));
+        return Some(
+            setup
+                .sliding_block()
+                .steps(setup.duration, &Default::default()),
+        );
     }
     let (roles, alpha, _) = setup.two_block()?;
-    if crate::headless::simulate::needs_stepped(setup) {
-        let building =
-            crate::analytic::ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, 0.0)
-                .ok()?;
-        let structure = building.sliding_structure(
-            setup.joint_law(),
-            nalgebra::DMatrix::zeros(1, 1),
-            &setup.motion,
-            setup.vertical.as_ref(),
-        );
+    if setup.needs_stepped_exact() {
+        let structure = setup.two_block_structure()?.ok()?;
         return Some(structure.steps(setup.duration, &Default::default()));
     }
     // The slip phase's structure frequency ω/√(1 − α) is the higher one.

@@ -6,6 +6,7 @@ use std::sync::Arc;
 use super::response::Probe;
 use super::spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 use super::{check, defaults};
+use crate::analytic::{ShearBuilding, SlidingBlock, SlidingStructure};
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
@@ -454,6 +455,44 @@ impl RunSetup {
             .map_or(Friction::Coulomb(self.friction), |c| c.friction)
     }
 
+    /// Whether the mass-spring model of this run needs the stepped solution: a friction
+    /// law other than Coulomb's, vertical shaking or damping, which the closed-form
+    /// propagation does not have.
+    pub fn needs_stepped_exact(&self) -> bool {
+        !matches!(self.joint_law(), Friction::Coulomb(_))
+            || self.vertical.is_some()
+            || self.damping_ratio > 0.0
+    }
+
+    /// The rigid sliding block of a `block` run (its exact model's input).
+    pub fn sliding_block(&self) -> SlidingBlock<'_> {
+        SlidingBlock {
+            friction: self.joint_law(),
+            gravity: self.scene.gravity,
+            horizontal: &self.motion,
+            vertical: self.vertical.as_ref(),
+        }
+    }
+
+    /// The two-mass model of a two-block run as a sliding structure for the stepped
+    /// solution (unit total mass, the run's law, damping and motions); `None` for other
+    /// scenes.
+    pub fn two_block_structure(&self) -> Option<Result<SlidingStructure<'_>>> {
+        let (roles, alpha, _) = self.two_block()?;
+        let hz = roles.structure_frequency_hz;
+        Some(ShearBuilding::two_mass(alpha, hz, 0.0).map(|building| {
+            // c = 2ζ√(k m) = 2ζ·m·ω on the unit-mass model (m = α).
+            let omega = 2.0 * std::f64::consts::PI * hz;
+            let damping = 2.0 * self.damping_ratio * alpha * omega;
+            building.sliding_structure(
+                self.joint_law(),
+                nalgebra::DMatrix::from_element(1, 1, damping),
+                &self.motion,
+                self.vertical.as_ref(),
+            )
+        }))
+    }
+
     /// The run's scene with the sliding joint bonded (the fixed-base comparison).
     pub fn fixed_base_scene(&self) -> Scene {
         let mut scene = self.scene.clone();
@@ -493,11 +532,10 @@ impl RunSetup {
 
 /// α = m/(M + m) of a two-block scene as written (roof and raft masses).
 fn scene_alpha(scene: &Scene, roles: &TwoBlockRoles) -> Result<f64> {
-    let mass = |name: &str| -> Result<f64> {
-        let b = &scene.blocks[scene.block_index(name)?];
-        Ok(b.material.density * crate::model::geometry::moments(&b.vertices, &b.name)?.area)
-    };
-    let (m, big_m) = (mass(&roles.roof)?, mass(&roles.raft)?);
+    let (m, big_m) = (
+        scene.block_mass(&roles.roof)?,
+        scene.block_mass(&roles.raft)?,
+    );
     Ok(m / (m + big_m))
 }
 

@@ -130,8 +130,7 @@ impl Dda {
                 let sliding = matches!(new_state, ContactState::Sliding { .. });
                 let mu_moved = (mu_alpha - c.sliding_coefficient).abs()
                     > 1e-4 * mu_alpha.max(c.sliding_coefficient);
-                let n_moved =
-                    (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha);
+                let n_moved = (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha);
                 if sliding && (mu_moved || n_moved) {
                     changed = true;
                 }
