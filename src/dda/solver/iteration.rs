@@ -130,18 +130,13 @@ impl Dda {
                 let sliding = matches!(new_state, ContactState::Sliding { .. });
                 let mu_moved = (mu_alpha - c.sliding_coefficient).abs()
                     > 1e-4 * mu_alpha.max(c.sliding_coefficient);
-                let n_moved = (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha);
-                if sliding && (mu_moved || n_moved) {
+                if sliding
+                    && (mu_moved
+                        || (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha))
+                {
                     changed = true;
                 }
-                // In a time step, a normal force within the tolerance is left as the solve
-                // used it (see the coefficient below): under vertical shaking N changes
-                // every step, and booking (and carrying) the re-evaluated one left 1.2e-7
-                // of the block's energy unaccounted. The settle keeps iterating on it.
-                let dynamic = matches!(mode, Mode::Dynamic { .. });
-                if n_moved || !sliding || !dynamic {
-                    c.friction_normal = n_alpha;
-                }
+                c.friction_normal = n_alpha;
                 // A coefficient within the tolerance is left as the solve used it, so that
                 // the friction work booked and the force carried into the next step are
                 // the ones the step was solved with (the energy balance of a velocity law

@@ -90,7 +90,7 @@ impl Dda {
                         } else {
                             c.props.friction.sliding_coefficient(c.end_slip_velocity)
                         };
-                        (0.0, normal, -direction * mu * c.friction_normal.max(0.0))
+                        (0.0, normal, -direction * mu * normal.max(0.0))
                     }
                 }
             } else {
