@@ -33,6 +33,7 @@ fn sweep_with(
         frictions,
         freq_ratios: ratios,
         amplitude_g: 0.3,
+        damping: None,
         duration: Some(duration),
         dt: Some(1e-3),
         integrator: Some(integrator),

@@ -531,6 +531,7 @@ fn a_sweep_with_infinite_friction_is_refused_before_running() {
         frictions: vec![f64::INFINITY],
         freq_ratios: vec![1.0],
         amplitude_g: 0.3,
+        damping: None,
         duration: Some(1.0),
         dt: None,
         integrator: None,

@@ -364,6 +364,7 @@ fn time_sweep(options: &BenchOptions) -> Result<SweepTiming> {
         frictions,
         freq_ratios: ratios,
         amplitude_g: 0.3,
+        damping: None,
         duration: Some(100.0),
         dt: None,
         integrator: None,

@@ -20,6 +20,8 @@ pub struct SweepRequest {
     pub freq_ratios: Vec<f64>,
     /// Harmonic amplitude, g.
     pub amplitude_g: f64,
+    /// Structural damping ratio ζ of every run (both models), `None` undamped.
+    pub damping: Option<f64>,
     /// Duration of every run, s (default: the harmonic default of the run set-up).
     pub duration: Option<f64>,
     /// DDA time step, s (default: the run set-up's).
@@ -172,6 +174,7 @@ impl SweepRequest {
             },
             alpha: Some(alpha),
             friction: Some(friction),
+            damping: self.damping,
             duration: self.duration,
             // The exact model has no time step or integrator.
             dt: if dda { self.dt } else { None },
@@ -279,6 +282,7 @@ pub fn run_sweep(
                         alpha,
                         friction,
                         freq_ratio,
+                        damping: req.damping.unwrap_or(0.0),
                         us_max_over_d: us,
                         ur_max_over_d: ur,
                         abase_over_aground: ab,
@@ -352,6 +356,7 @@ mod tests {
             frictions: vec![0.05, 0.1, 0.25],
             freq_ratios: vec![0.5, 1.0, 2.0],
             amplitude_g: 0.3,
+            damping: None,
             duration: Some(1.0),
             dt: None,
             integrator: None,

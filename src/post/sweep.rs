@@ -22,6 +22,10 @@ pub struct SweepRow {
     pub friction: f64,
     /// Ω/ω.
     pub freq_ratio: f64,
+    /// Structural damping ratio ζ (0: undamped; tables written before `sweep --damping`
+    /// have no such column and read as 0).
+    #[serde(default)]
+    pub damping: f64,
     /// max|u_s|/D.
     pub us_max_over_d: f64,
     /// max|u_r|/D.
@@ -48,11 +52,12 @@ pub const METRICS: [&str; 4] = [
 
 impl SweepRow {
     /// The columns of `sweep.csv`, in order.
-    pub const COLUMNS: [&'static str; 11] = [
+    pub const COLUMNS: [&'static str; 12] = [
         "model",
         "alpha",
         "friction",
         "freq_ratio",
+        "damping",
         "us_max_over_d",
         "ur_max_over_d",
         "abase_over_aground",
@@ -80,6 +85,9 @@ impl SweepRow {
                 "friction {} must be finite and >= 0",
                 self.friction
             ));
+        }
+        if !(0.0..1.0).contains(&self.damping) {
+            return Err(format!("damping {} is outside [0, 1)", self.damping));
         }
         if !(self.freq_ratio.is_finite() && self.freq_ratio > 0.0) {
             return Err(format!(
@@ -150,7 +158,9 @@ pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
         .iter()
         .map(str::to_string)
         .collect();
-    if header != SweepRow::COLUMNS {
+    // Tables from before the damping column are read as undamped.
+    let undamped_header = SweepRow::COLUMNS.iter().filter(|c| **c != "damping");
+    if header != SweepRow::COLUMNS && !header.iter().eq(undamped_header) {
         return Err(Error::parse(
             &label,
             1,
@@ -206,14 +216,38 @@ pub struct ErrorTable {
     pub unmatched: usize,
 }
 
-type Key = (u64, u64, u64);
+type Key = (u64, u64, u64, u64);
 
 fn key(r: &SweepRow) -> Key {
     (
         r.alpha.to_bits(),
         r.friction.to_bits(),
         r.freq_ratio.to_bits(),
+        r.damping.to_bits(),
     )
+}
+
+/// The one damping ratio of a sweep's rows; an error naming both when the rows mix two
+/// (the figures and the error table are of one structure: shards of different sweeps
+/// must not be merged into one).
+pub fn common_damping(rows: &[SweepRow]) -> std::result::Result<f64, String> {
+    let first = rows.first().map_or(0.0, |r| r.damping);
+    match rows.iter().find(|r| r.damping != first) {
+        Some(r) => Err(format!(
+            "the rows mix damping ratios {first} and {}; a sweep table is of one ζ",
+            r.damping
+        )),
+        None => Ok(first),
+    }
+}
+
+/// " (ζ = 2 %)" for a damped sweep, "" for an undamped one: added to figure titles.
+fn damping_label(zeta: f64) -> String {
+    if zeta > 0.0 {
+        format!(", ζ = {} %", 100.0 * zeta)
+    } else {
+        String::new()
+    }
 }
 
 /// Value at quantile q of sorted data (linear interpolation).
@@ -321,6 +355,7 @@ impl fmt::Display for ErrorTable {
 /// ((a) |u_s|/D, (b) |u_r|/D) and an acceleration figure ((a) |a_base|/a_g, (b) |a_roof|/a_g)
 /// against Ω/ω on log axes; exact model as lines, DDA as markers, one colour per ρ.
 pub fn plot_paper_figures(rows: &[SweepRow], out: &mut Staged) -> Result<()> {
+    let zeta = damping_label(rows.first().map_or(0.0, |r| r.damping));
     let mut alphas: Vec<f64> = rows.iter().map(|r| r.alpha).collect();
     alphas.sort_by(f64::total_cmp);
     alphas.dedup();
@@ -354,7 +389,8 @@ pub fn plot_paper_figures(rows: &[SweepRow], out: &mut Staged) -> Result<()> {
             };
             let mut fig = Figure::new(
                 format!(
-                    "{title}α = {alpha}, DDA (markers) against the exact mass-spring model (lines)"
+                    "{title}α = {alpha}{zeta}, DDA (markers) against the exact mass-spring model \
+                     (lines)"
                 ),
                 1,
                 2,
@@ -403,6 +439,7 @@ mod tests {
             alpha: 0.5,
             friction: 0.1,
             freq_ratio: ratio,
+            damping: 0.0,
             us_max_over_d: v,
             ur_max_over_d: v,
             abase_over_aground: v,
@@ -436,5 +473,39 @@ mod tests {
             0.01,
         );
         assert!((t.metrics[0].median - 0.5).abs() < 1e-12);
+    }
+
+    /// A table written before the damping column reads as undamped; a table mixing two
+    /// damping ratios is refused by the checks of merge and plotting.
+    #[test]
+    fn damping_column_old_tables_and_mixes() {
+        let dir = std::env::temp_dir().join(format!("slidebase-sweep-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let old = dir.join("old.csv");
+        let header: Vec<&str> = SweepRow::COLUMNS
+            .iter()
+            .copied()
+            .filter(|c| *c != "damping")
+            .collect();
+        std::fs::write(
+            &old,
+            format!(
+                "{}\ndda,0.5,0.1,2.0,1.0,1.0,1.0,1.0,10,0.1,0.0\n",
+                header.join(",")
+            ),
+        )
+        .unwrap();
+        let rows = read_sweep_csv(&old).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!(rows[0].damping, 0.0);
+        let new = dir.join("new.csv");
+        let mut damped = row("dda", 2.0, 1.0);
+        damped.damping = 0.05;
+        write_sweep_csv(&new, std::slice::from_ref(&damped)).unwrap();
+        assert_eq!(read_sweep_csv(&new).unwrap(), vec![damped.clone()]);
+        assert_eq!(common_damping(std::slice::from_ref(&damped)), Ok(0.05));
+        let err = common_damping(&[damped, row("dda", 1.0, 1.0)]).unwrap_err();
+        assert!(err.contains("0.05") && err.contains("mix"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
