@@ -493,10 +493,12 @@ fn merge_refuses_unusable_tables() {
         &["not a sweep table"],
     );
     for (row, what) in [
-        ("dda,0.5,0.1,1,NaN,1,1,1,5,0.1,0", "us_max_over_d NaN"),
-        ("dda,-5,0.1,1,1,1,1,1,5,0.1,0", "alpha -5"),
-        ("foo,0.5,0.1,1,1,1,1,1,5,0.1,0", "unknown model 'foo'"),
-        ("dda,0.5,inf,1,1,1,1,1,5,0.1,0", "friction inf"),
+        ("dda,0.5,0.1,1,0,NaN,1,1,1,5,0.1,0", "us_max_over_d NaN"),
+        ("dda,-5,0.1,1,0,1,1,1,1,5,0.1,0", "alpha -5"),
+        ("foo,0.5,0.1,1,0,1,1,1,1,5,0.1,0", "unknown model 'foo'"),
+        ("dda,0.5,inf,1,0,1,1,1,1,5,0.1,0", "friction inf"),
+        ("dda,0.5,0.1,1,1.5,1,1,1,1,5,0.1,0", "damping 1.5"),
+        ("dda,0.5,0.1,1,1,1,1,1,5,0.1,0", "11 fields"),
     ] {
         let e = read_table(&format!("{header}\n{row}\n")).unwrap_err();
         assert_has(&e.to_string(), &["sweep.csv:2", what]);

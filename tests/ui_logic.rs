@@ -393,3 +393,54 @@ fn plot_data_export_writes_well_formed_csv() {
     let rows: Vec<csv::StringRecord> = spectrum.records().map(Result::unwrap).collect();
     assert!(rows.len() > 10 && rows.iter().all(|r| r.len() == 4));
 }
+
+/// Issue 15: the "vertical shaking" toggle adds El Centro's vertical component to the
+/// run (and to nothing else); it is greyed out for input without one (a sine wave).
+#[test]
+fn the_vertical_toggle_adds_the_vertical_record() {
+    let mut h = harness(AppState::default(), 1600.0, 900.0);
+    h.state_mut().take_commands();
+    h.get_by_label("vertical shaking").click();
+    h.run_steps(2);
+    let r = runs(&h.state_mut().take_commands());
+    let last = r.last().expect("the toggle restarts the run");
+    assert_eq!(last.vertical.as_deref(), Some("el-centro-up"));
+    assert_eq!(last.damping, None, "damping is for the two-block scene");
+    slidebase::sim::prepare(last).expect("the vertical run sets up");
+    // A sine wave has no vertical component: the toggle does not apply.
+    let mut controls = h.state().controls.clone();
+    controls.record = slidebase::ui::RecordChoice::Harmonic;
+    assert!(controls.vertical, "the choice is kept...");
+    assert_eq!(controls.config().vertical, None, "...but not applied");
+}
+
+/// Issue 15: the two-block scene has a damping slider; a damped run's exact overlay is
+/// the damped exact solution (it differs from the undamped one).
+#[test]
+fn the_two_block_scene_offers_damping() {
+    let mut controls = slidebase::ui::Controls {
+        scene: slidebase::ui::SceneChoice::TwoBlock,
+        record: slidebase::ui::RecordChoice::Harmonic,
+        ..Default::default()
+    };
+    let h = harness(AppState::new(controls.clone()), 1600.0, 900.0);
+    assert!(h.query_all_by_label_contains("damping ζ").next().is_some());
+    assert_eq!(controls.config().damping, None, "0 is undamped");
+    let undamped = slidebase::sim::prepare(&controls.config()).unwrap();
+    controls.damping = 0.05;
+    assert_eq!(controls.config().damping, Some(0.05));
+    let damped = slidebase::sim::prepare(&controls.config()).unwrap();
+    let peak = |r: &slidebase::sim::PreparedRun| {
+        let e = r
+            .exact
+            .as_ref()
+            .expect("two-block runs have the exact overlay");
+        e.drift.iter().fold(0.0_f64, |m, d| m.max(d.abs()))
+    };
+    assert!(
+        peak(&damped) < 0.9 * peak(&undamped),
+        "damped exact drift {} against undamped {}",
+        peak(&damped),
+        peak(&undamped)
+    );
+}

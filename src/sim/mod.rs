@@ -15,11 +15,11 @@ use std::time::{Duration, Instant};
 pub use frame::{Attached, BlockFrame, ContactFrame, Extractor, ModelFrame, Probes, Samples};
 
 use crate::Result;
-use crate::analytic::{ExactOptions, ShearBuilding, simulate};
+use crate::analytic::{ExactOptions, ShearBuilding, SteppedOptions, simulate, simulate_stepped};
 use crate::dda::{Dda, Integrator};
 use crate::ground_motion::GroundMotion;
 use crate::model::Scene;
-use crate::setup::{ExcitationSpec, Frequency, RunSetup, RunSpec};
+use crate::setup::{ExcitationSpec, Frequency, RunSetup, RunSpec, VerticalSpec};
 
 /// The ground motion of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,6 +64,10 @@ pub struct SimConfig {
     pub duration: Option<f64>,
     /// Simulated time between published frames, s.
     pub frame_dt: f64,
+    /// Structural damping ratio ζ (two-block scenes; None: undamped).
+    pub damping: Option<f64>,
+    /// Vertical ground motion: a built-in `-up` record or a file (None: horizontal only).
+    pub vertical: Option<String>,
 }
 
 impl Default for SimConfig {
@@ -82,6 +86,8 @@ impl Default for SimConfig {
             // 100 frames per simulated second: smooth replay at up to 2× speed at 60 Hz,
             // and about 6 MB for a 30 s three-storey run.
             frame_dt: 0.01,
+            damping: None,
+            vertical: None,
         }
     }
 }
@@ -193,6 +199,11 @@ impl SimConfig {
             dt: Some(self.dt),
             integrator: Some(self.integrator),
             pga_g: self.pga_g,
+            damping: self.damping,
+            vertical: self.vertical.as_ref().map(|source| VerticalSpec {
+                source: source.clone(),
+                scale: 1.0,
+            }),
             ..RunSpec::default()
         })
     }
@@ -320,6 +331,24 @@ fn exact_overlay(setup: &RunSetup, frame_dt: f64) -> Result<Option<ExactOverlay>
     let Some((roles, alpha, _)) = setup.two_block() else {
         return Ok(None);
     };
+    // Damping, vertical shaking or another friction law: the stepped exact solution.
+    if setup.needs_stepped_exact()
+        && let Some(structure) = setup.two_block_structure()
+    {
+        let r = simulate_stepped(
+            &structure?,
+            setup.duration,
+            frame_dt,
+            &SteppedOptions::default(),
+        )?;
+        return Ok(Some(ExactOverlay {
+            slip: r.slip,
+            drift: r.roof_drift,
+            base_accel: r.raft_accel,
+            roof_accel: r.roof_accel,
+            time: r.time,
+        }));
+    }
     let b = ShearBuilding::two_mass(alpha, roles.structure_frequency_hz, setup.friction)?;
     let r = simulate(
         &b,
@@ -489,7 +518,7 @@ fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
         generation += 1;
         match run_one(generation, &config, &commands, &out) {
             RunEnd::Finished | RunEnd::Failed => {}
-            RunEnd::Replaced(next) => pending = Some(next),
+            RunEnd::Replaced(next) => pending = Some(*next),
             RunEnd::Quit => return,
         }
     }
@@ -498,7 +527,7 @@ fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
 enum RunEnd {
     Finished,
     Failed,
-    Replaced(SimConfig),
+    Replaced(Box<SimConfig>),
     Quit,
 }
 
@@ -528,7 +557,7 @@ fn run_one(
     loop {
         // Commands first: a new run replaces this one at once.
         match commands.try_recv() {
-            Ok(SimCommand::Run(c)) => return RunEnd::Replaced(*c),
+            Ok(SimCommand::Run(c)) => return RunEnd::Replaced(c),
             Ok(SimCommand::Quit) | Err(TryRecvError::Disconnected) => return RunEnd::Quit,
             Err(TryRecvError::Empty) => {}
         }

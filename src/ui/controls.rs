@@ -86,6 +86,14 @@ impl AppState {
         if self.controls.scene == SceneChoice::TwoBlock {
             ui.add(egui::Slider::new(&mut self.controls.alpha, 0.05..=0.95).text("mass ratio α"))
                 .on_hover_text("the structure's share of the total mass: α = m / (M + m)");
+            let r = ui
+                .add(egui::Slider::new(&mut self.controls.damping, 0.0..=0.2).text("damping ζ"))
+                .on_hover_text(
+                    "structural damping: a dashpot beside the spring, ζ of critical (0.02 to \
+                     0.05 is typical of buildings); the sliding itself is never damped. The \
+                     exact solution drawn dashed is damped alike",
+                );
+            self.widget_rects.insert("damping", r.rect);
         }
     }
 
@@ -176,6 +184,7 @@ impl AppState {
                     self.controls.pga_g = None;
                 }
             });
+            self.vertical_toggle(ui);
         }
         ui.horizontal(|ui| {
             let field = ui
@@ -195,6 +204,26 @@ impl AppState {
                 self.load_path();
             }
         });
+    }
+
+    /// "vertical shaking": adds El Centro's vertical component (the normal force, and with
+    /// it the friction capacity, follows the ground's vertical acceleration).
+    fn vertical_toggle(&mut self, ui: &mut egui::Ui) {
+        let available = self.controls.vertical_available();
+        let r = ui
+            .add_enabled(
+                available,
+                egui::Checkbox::new(&mut self.controls.vertical, "vertical shaking"),
+            )
+            .on_hover_text(
+                "shake the ground up and down too, with the station's vertical record \
+                 (el-centro-up): the weight on the sliding joint, and with it the friction \
+                 that can hold the base, rises and falls with the ground",
+            )
+            .on_disabled_hover_text(
+                "only the El Centro records come with their vertical component here",
+            );
+        self.widget_rects.insert("vertical", r.rect);
     }
 
     fn section_compare(&mut self, ui: &mut egui::Ui) {

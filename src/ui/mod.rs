@@ -119,7 +119,15 @@ pub struct Controls {
     pub dt: f64,
     /// What runs beside the model.
     pub comparison: Comparison,
+    /// Structural damping ratio ζ (two-block scene; 0: undamped).
+    pub damping: f64,
+    /// Shake the ground vertically too, with the record's own vertical component
+    /// ([`VERTICAL_RECORD`]; El Centro records only).
+    pub vertical: bool,
 }
+
+/// The vertical component the "vertical shaking" toggle adds (the only built-in one).
+pub const VERTICAL_RECORD: &str = "el-centro-up";
 
 impl Default for Controls {
     fn default() -> Self {
@@ -134,11 +142,20 @@ impl Default for Controls {
             integrator: Integrator::default(),
             dt: 1e-3,
             comparison: Comparison::FixedBase,
+            damping: 0.0,
+            vertical: false,
         }
     }
 }
 
 impl Controls {
+    /// Whether the vertical toggle applies: a built-in El Centro horizontal component,
+    /// whose station recorded the vertical one the toggle adds.
+    pub fn vertical_available(&self) -> bool {
+        matches!(&self.record, RecordChoice::Builtin(n)
+            if n.starts_with("el-centro") && !n.ends_with("-up"))
+    }
+
     /// The simulation configuration these controls describe.
     pub fn config(&self) -> SimConfig {
         let two_block = self.scene == SceneChoice::TwoBlock;
@@ -169,6 +186,9 @@ impl Controls {
                 _ => self.pga_g,
             },
             duration: None,
+            damping: (two_block && self.damping > 0.0).then_some(self.damping),
+            vertical: (self.vertical && self.vertical_available())
+                .then(|| VERTICAL_RECORD.to_string()),
             ..SimConfig::default()
         }
     }
