@@ -79,8 +79,8 @@ enum GroundArg {
 #[derive(Debug, clap::Args)]
 struct RunArgs {
     /// Built-in scene (`two-block`, `three-storey`, `block`: Newmark's sliding block;
-    /// `slidebase list` names them all), a generated one (`frame:N`, `wall:N`) or a scene
-    /// TOML file.
+    /// `slidebase list` names them all), a generated one (`friction-pendulum`, `frame:N`,
+    /// `wall:N`) or a scene TOML file.
     #[arg(long, default_value = "two-block")]
     scene: String,
     /// Mass ratio α = m/(M + m) of roof to total mass, in (0, 1) (two-block scenes;
@@ -133,6 +133,11 @@ struct RunArgs {
     /// beside the spring, in DDA and the exact model alike; sliding is never damped).
     #[arg(long, allow_hyphen_values = true)]
     damping: Option<f64>,
+    /// Effective radius R of the friction pendulum's dish, m (`--scene friction-pendulum`
+    /// only; default 2): the radius the slider's centroid travels on, so that its small
+    /// free oscillations take 2π√(R/g).
+    #[arg(long, allow_hyphen_values = true)]
+    radius: Option<f64>,
     /// Ground model of the DDA run (default: the scene's).
     #[arg(long, value_enum)]
     ground: Option<GroundArg>,
@@ -385,6 +390,25 @@ fn out(line: &str) -> Result<()> {
 
 /// The run specification of `run`'s flags (every check is the set-up's, shared with the
 /// visualizer and the studies).
+/// The scene `--scene` names, with the friction pendulum's `--radius` applied.
+fn scene_name(args: &RunArgs) -> Result<String> {
+    let Some(radius) = args.radius else {
+        return Ok(args.scene.clone());
+    };
+    if args.scene != slidebase::model::pendulum::NAME {
+        return Err(slidebase::Error::invalid(
+            "--radius",
+            format!(
+                "sets the dish radius of --scene {}; '{}' has no dish",
+                slidebase::model::pendulum::NAME,
+                args.scene
+            ),
+        )
+        .into());
+    }
+    Ok(format!("{}:{radius}", args.scene))
+}
+
 fn run_spec(args: &RunArgs) -> Result<RunSpec> {
     let integrator = args.stepping.integrator()?;
     let excitation = match &args.record {
@@ -398,7 +422,7 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
         None => ExcitationSpec::Scene,
     };
     Ok(RunSpec {
-        scene: args.scene.as_str().into(),
+        scene: scene_name(args)?.into(),
         model: args.model.into(),
         excitation,
         vertical: args.vertical_record.as_ref().map(|source| VerticalSpec {
@@ -1060,6 +1084,14 @@ fn cmd_modes(args: ModesArgs) -> Result<()> {
 fn cmd_list() -> Result<()> {
     out("scenes:")?;
     for s in slidebase::model::presets::builtin_names() {
+        out(&format!("  {s}"))?;
+    }
+    out("generated scenes:")?;
+    for s in [
+        "friction-pendulum (--radius R, or friction-pendulum:R)",
+        "frame:N",
+        "wall:N",
+    ] {
         out(&format!("  {s}"))?;
     }
     out("records:")?;

@@ -20,7 +20,7 @@ pub use exact::{EnergyBalance, ExactOptions, ExactResult, Peaks, Phase, PhaseEve
 pub use sdof::sdof_harmonic_from_rest;
 pub use sliding_block::{SlidingBlock, simulate_block};
 pub use stepped::{
-    SlidingStructure, SteppedEnergy, SteppedOptions, SteppedResult, simulate_stepped,
+    SlidingStructure, SteppedEnergy, SteppedOptions, SteppedResult, Surface, simulate_stepped,
 };
 
 use crate::ground_motion::STANDARD_GRAVITY;
@@ -119,6 +119,7 @@ impl ShearBuilding {
             gravity: self.gravity,
             horizontal,
             vertical,
+            surface: Surface::Flat,
         }
     }
 

@@ -19,7 +19,7 @@
 
 use nalgebra::DMatrix;
 
-use super::stepped::{SlidingStructure, SteppedOptions, SteppedResult, simulate_stepped};
+use super::stepped::{SlidingStructure, SteppedOptions, SteppedResult, Surface, simulate_stepped};
 use crate::Result;
 use crate::ground_motion::GroundMotion;
 use crate::model::friction::Friction;
@@ -35,6 +35,8 @@ pub struct SlidingBlock<'a> {
     pub horizontal: &'a GroundMotion,
     /// Vertical ground acceleration (up positive), if the ground also shakes vertically.
     pub vertical: Option<&'a GroundMotion>,
+    /// The surface it slides on: flat, or a friction pendulum's dish.
+    pub surface: Surface,
 }
 
 impl<'a> SlidingBlock<'a> {
@@ -49,6 +51,7 @@ impl<'a> SlidingBlock<'a> {
             gravity: self.gravity,
             horizontal: self.horizontal,
             vertical: self.vertical,
+            surface: self.surface,
         }
     }
 
@@ -87,6 +90,7 @@ mod tests {
             gravity: 9.81,
             horizontal: motion,
             vertical: None,
+            surface: Surface::Flat,
         };
         simulate_block(&block, duration, 0.0, &SteppedOptions::default()).unwrap()
     }
@@ -144,6 +148,7 @@ mod tests {
                 gravity: 9.81,
                 horizontal: &m,
                 vertical: None,
+                surface: Surface::Flat,
             };
             let coarse = simulate_block(&block, 6.0, 0.0, &SteppedOptions::default()).unwrap();
             let fine_options = SteppedOptions {
@@ -171,6 +176,7 @@ mod tests {
             gravity: 9.80665,
             horizontal: &h,
             vertical: Some(&v),
+            surface: Surface::Flat,
         };
         let err = simulate_block(&block, 2.0, 0.0, &SteppedOptions::default()).unwrap_err();
         let text = err.to_string();

@@ -21,9 +21,13 @@ use crate::{Error, Result};
 /// 1602): beyond it a run needs more memory and time than a study should silently take.
 pub const MAX_SIZE: usize = 100;
 
-/// A generated scene from its spelling `frame:N` or `wall:N`, or `None` when the name is
+/// A generated scene from its spelling `frame:N`, `wall:N` or `friction-pendulum[:R]`
+/// (see [`super::pendulum`]), or `None` when the name is
 /// not of that form.
 pub fn resolve_generated(name: &str) -> Option<Result<Scene>> {
+    if let Some(pendulum) = super::pendulum::resolve(name) {
+        return Some(pendulum);
+    }
     let (kind, size) = name.split_once(':')?;
     let build: fn(usize) -> Result<Scene> = match kind {
         "frame" => frame,

@@ -4,6 +4,7 @@ pub mod friction;
 pub mod generated;
 pub mod geometry;
 pub mod material;
+pub mod pendulum;
 pub mod presets;
 pub mod scene;
 pub mod validate;

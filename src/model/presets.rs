@@ -41,7 +41,10 @@ pub fn resolve_scene(name_or_path: &str) -> Result<Scene> {
     Err(Error::Unknown {
         kind: "scene",
         name: name_or_path.to_string(),
-        known: format!("{}, frame:N, wall:N", builtin_names().join(", ")),
+        known: format!(
+            "{}, frame:N, wall:N, friction-pendulum[:R]",
+            builtin_names().join(", ")
+        ),
     })
 }
 

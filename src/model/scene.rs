@@ -362,6 +362,11 @@ pub struct SlidingBlockRoles {
     pub block: String,
     /// The joint between the block and the ground (contact name).
     pub joint: String,
+    /// A friction pendulum: the effective radius R of the ground's dish, m — the radius of
+    /// the circle the block's centroid travels on (the dish's radius less the distance from
+    /// the block's bottom to its centroid). Absent: a flat joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dish_radius: Option<f64>,
 }
 
 /// Names the parts of a two-mass scene (paper Fig. 2) so that α, ρ and Ω/ω can be set.

@@ -218,6 +218,16 @@ fn check_sliding_block_roles(scene: &Scene, names: &HashMap<&str, usize>, ground
             ),
         ));
     }
+    if let Some(radius) = r.dish_radius {
+        let (lo, hi) = super::pendulum::RADIUS_RANGE_M;
+        if !(lo..=hi).contains(&radius) {
+            return Err(Issue::new(
+                at("dish_radius"),
+                "sliding_block.dish_radius",
+                format!("the effective radius must be in [{lo}, {hi}] m, got {radius}"),
+            ));
+        }
+    }
     check_joint(
         scene,
         &r.joint,

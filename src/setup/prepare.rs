@@ -6,7 +6,7 @@ use std::sync::Arc;
 use super::response::Probe;
 use super::spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 use super::{check, defaults};
-use crate::analytic::{ShearBuilding, SlidingBlock, SlidingStructure};
+use crate::analytic::{ShearBuilding, SlidingBlock, SlidingStructure, Surface};
 use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
@@ -471,6 +471,17 @@ impl RunSetup {
             gravity: self.scene.gravity,
             horizontal: &self.motion,
             vertical: self.vertical.as_ref(),
+            surface: self
+                .dish_radius()
+                .map_or(Surface::Flat, |radius| Surface::Circle { radius }),
+        }
+    }
+
+    /// The effective radius of a friction pendulum's dish (`None`: a flat joint).
+    pub fn dish_radius(&self) -> Option<f64> {
+        match &self.roles {
+            SceneRoles::Block(roles) => roles.dish_radius,
+            SceneRoles::TwoBlock { .. } | SceneRoles::Building(_) => None,
         }
     }
 
