@@ -388,8 +388,6 @@ fn out(line: &str) -> Result<()> {
     }
 }
 
-/// The run specification of `run`'s flags (every check is the set-up's, shared with the
-/// visualizer and the studies).
 /// The scene `--scene` names, with the friction pendulum's `--radius` applied.
 fn scene_name(args: &RunArgs) -> Result<String> {
     let Some(radius) = args.radius else {
@@ -399,9 +397,10 @@ fn scene_name(args: &RunArgs) -> Result<String> {
         return Err(slidebase::Error::invalid(
             "--radius",
             format!(
-                "sets the dish radius of --scene {}; '{}' has no dish",
-                slidebase::model::pendulum::NAME,
-                args.scene
+                "sets the dish radius of --scene {name} (or spell the scene {name}:R); \
+                 '{}' is not that scene",
+                args.scene,
+                name = slidebase::model::pendulum::NAME
             ),
         )
         .into());
@@ -409,6 +408,8 @@ fn scene_name(args: &RunArgs) -> Result<String> {
     Ok(format!("{}:{radius}", args.scene))
 }
 
+/// The run specification of `run`'s flags (every check is the set-up's, shared with the
+/// visualizer and the studies).
 fn run_spec(args: &RunArgs) -> Result<RunSpec> {
     let integrator = args.stepping.integrator()?;
     let excitation = match &args.record {

@@ -463,10 +463,9 @@ impl<'a, 'b> Stepper<'a, 'b> {
                 .zip(du.iter())
                 .map(|(m, w)| m * w)
                 .sum::<f64>();
-        dy[k] = match self.st.surface {
-            Surface::Flat | Surface::Linearised { .. } => -a_g * momentum,
-            Surface::Circle { .. } => -a_g * momentum * support.cos,
-        } - self.vertical_accel(t) * self.st.total_mass() * support.rise_rate;
+        // The raft's horizontal velocity is its path velocity times the slope's cos θ.
+        dy[k] = -a_g * momentum * support.cos
+            - self.vertical_accel(t) * self.st.total_mass() * support.rise_rate;
         dy[k + 1] = friction_power;
         dy[k + 2] = du.dot(&cdu);
         dy

@@ -270,16 +270,12 @@ fn detect_one_way(
         {
             continue;
         }
-        let n_prev = vblock.edges[(vi + nv - 1) % nv].normal;
-        let n_next = vblock.edges[vi].normal;
+        let (before, after) = (&vblock.edges[(vi + nv - 1) % nv], &vblock.edges[vi]);
+        let (n_prev, n_next) = (before.normal, after.normal);
         // A reflex vertex (the inside of a dish, a notch) cannot be the first point of
         // its block to touch an edge: its own two edges meet the other block first, and
         // the other block's vertices on them are the contacts.
-        if cross(
-            vblock.edges[(vi + nv - 1) % nv].tangent,
-            vblock.edges[vi].tangent,
-        ) < -1e-12
-        {
+        if cross(before.tangent, after.tangent) < -1e-12 {
             continue;
         }
         // Best candidate edge: smallest |gap|, preferring the edge this vertex touched last.

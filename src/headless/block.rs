@@ -240,11 +240,10 @@ pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
     let options = SteppedOptions::default();
     let r = simulate_block(&setup.sliding_block(), setup.duration, output_dt, &options)?;
     let mass = setup.scene.block_mass(&setup.base)?;
-    let duration = setup.duration;
     Ok(simulate::stepped_model_run(
         &r,
         &setup.motion,
-        duration,
+        setup.duration,
         true,
         mass,
         start,

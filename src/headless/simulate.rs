@@ -351,11 +351,10 @@ pub fn run_exact_two_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun>
     let start = Instant::now();
     let options = crate::analytic::SteppedOptions::default();
     let r = crate::analytic::simulate_stepped(&structure?, setup.duration, output_dt, &options)?;
-    let duration = setup.duration;
     Ok(stepped_model_run(
         &r,
         &setup.motion,
-        duration,
+        setup.duration,
         true,
         roles.total_mass,
         start,
