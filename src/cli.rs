@@ -129,10 +129,16 @@ struct RunArgs {
     /// Factor on the vertical record's accelerations (default 1).
     #[arg(long, requires = "vertical_record", allow_hyphen_values = true)]
     vertical_scale: Option<f64>,
-    /// Structural damping ratio ζ, e.g. 0.05 (two-block scenes: a dashpot c = 2ζ√(k m)
-    /// beside the spring, in DDA and the exact model alike; sliding is never damped).
+    /// Structural damping ratio ζ, e.g. 0.05, in DDA and the exact model alike; sliding is
+    /// never damped. Two-block scenes: a dashpot c = 2ζ√(k m) beside the spring. Frames
+    /// (three-storey, frame:N): Rayleigh damping, ζ at the first two fixed-base modes.
     #[arg(long, allow_hyphen_values = true)]
     damping: Option<f64>,
+    /// The bearing under a frame's base slab: flat (the paper's Coulomb joint, default) or
+    /// pendulum:R (two friction-pendulum bearings of effective radius R m, 0.5 to 20; the
+    /// exact model is then the linearised bearing, a restoring force W·x/R).
+    #[arg(long, value_name = "flat|pendulum:R")]
+    bearing: Option<String>,
     /// Effective radius R of the friction pendulum's dish, m (`--scene friction-pendulum`
     /// only; default 2): the radius the slider's centroid travels on, so that its small
     /// free oscillations take 2π√(R/g).
@@ -435,6 +441,11 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
         friction_law: args.friction_law,
         fixed_base: args.fixed_base,
         damping: args.damping,
+        bearing: args
+            .bearing
+            .as_deref()
+            .map(slidebase::model::bearing::Bearing::parse)
+            .transpose()?,
         pga_g: None,
         ground: args.ground.map(|g| match g {
             GroundArg::Prescribed => GroundKind::Prescribed,
@@ -754,6 +765,9 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         friction,
         s.duration_s,
     ))?;
+    if let Some(b) = &s.bearing {
+        out(&format!("  bearing               {b} (friction pendulum)"))?;
+    }
     out(&format!(
         "  max slip              {:.4} m (residual {:.4} m)",
         s.max_slip_m, s.residual_slip_m

@@ -405,7 +405,7 @@ fn the_vertical_toggle_adds_the_vertical_record() {
     let r = runs(&h.state_mut().take_commands());
     let last = r.last().expect("the toggle restarts the run");
     assert_eq!(last.vertical.as_deref(), Some("el-centro-up"));
-    assert_eq!(last.damping, None, "damping is for the two-block scene");
+    assert_eq!(last.damping, None, "undamped unless the slider is moved");
     slidebase::sim::prepare(last).expect("the vertical run sets up");
     // A sine wave has no vertical component: the toggle does not apply.
     let mut controls = h.state().controls.clone();
@@ -443,4 +443,25 @@ fn the_two_block_scene_offers_damping() {
         peak(&damped),
         peak(&undamped)
     );
+}
+
+/// Issue 15: the frames have the damping slider too (Rayleigh damping), the wall of loose
+/// blocks does not; a damped frame run sets up with the frame's Rayleigh coefficients.
+#[test]
+fn the_frames_offer_rayleigh_damping_and_the_wall_does_not() {
+    let h = harness(AppState::default(), 1600.0, 900.0);
+    assert!(h.query_all_by_label_contains("damping ζ").next().is_some());
+    let mut controls = h.state().controls.clone();
+    controls.damping = 0.05;
+    let config = controls.config();
+    assert_eq!(config.damping, Some(0.05));
+    slidebase::sim::prepare(&config).expect("a damped frame sets up");
+    let wall = slidebase::ui::Controls {
+        scene: slidebase::ui::SceneChoice::Wall(4),
+        damping: 0.05,
+        ..Default::default()
+    };
+    assert_eq!(wall.config().damping, None, "a wall is not damped");
+    let h = harness(AppState::new(wall), 1600.0, 900.0);
+    assert!(h.query_all_by_label_contains("damping ζ").next().is_none());
 }

@@ -123,6 +123,31 @@ impl ShearBuilding {
         }
     }
 
+    /// The Rayleigh damping matrix C = a₀M + a₁K of the storeys (on their displacements
+    /// relative to the raft, so the sliding is not damped), with ratio `zeta` at the first
+    /// two fixed-base modes (at the only one of a single storey: a₀ = ζω, a₁ = ζ/ω), the
+    /// same rule as the DDA frame's ([`crate::dda::RayleighDamping`]).
+    pub fn rayleigh_damping(&self, zeta: f64) -> Result<nalgebra::DMatrix<f64>> {
+        let omega: Vec<f64> = self
+            .fixed_base_frequencies_hz()
+            .iter()
+            .map(|f| 2.0 * std::f64::consts::PI * f)
+            .collect();
+        let (w1, w2) = match omega.as_slice() {
+            [w] => (*w, *w),
+            [w1, w2, ..] => (*w1, *w2),
+            [] => {
+                return Err(Error::invalid(
+                    "--damping",
+                    "the shear building has no natural frequency to damp",
+                ));
+            }
+        };
+        let r = crate::dda::RayleighDamping::from_two_modes(zeta, w1, w2)?;
+        let (m, k) = exact::stick_matrices(self);
+        Ok(m * r.mass_coefficient + k * r.stiffness_coefficient)
+    }
+
     /// Fixed-base natural frequencies, Hz, ascending.
     pub fn fixed_base_frequencies_hz(&self) -> Vec<f64> {
         let (m, k) = exact::stick_matrices(self);

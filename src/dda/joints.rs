@@ -60,6 +60,23 @@ impl ElementTerms {
         &self.fe[..2 * self.count]
     }
 
+    /// These terms as a viscous element of damping coefficient `coefficient` times this
+    /// stiffness (Rayleigh's a₁·K): the stiffness `coefficient · gain · ke` (`gain` =
+    /// γ/(βΔt), the end velocity's share of the increment) and the start force
+    /// `coefficient · ke · velocities` (the nodes' predicted velocities, flattened).
+    pub fn as_dashpot(&self, coefficient: f64, gain: f64, velocities: &[f64; 6]) -> Self {
+        let dim = 2 * self.count;
+        let mut out = Self::with_nodes(self.nodes());
+        for i in 0..dim {
+            for j in 0..dim {
+                let k = self.ke[i * dim + j];
+                out.ke[i * dim + j] = coefficient * gain * k;
+                out.fe[i] += coefficient * k * velocities[j];
+            }
+        }
+        out
+    }
+
     /// Node forces at the end of the step: fe + ke·u (the first 2n entries).
     pub fn end_forces(&self, u: &[Point]) -> [f64; 6] {
         let dim = 2 * self.count;

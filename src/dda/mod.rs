@@ -16,9 +16,11 @@ pub mod joints;
 pub mod judge;
 pub mod linear;
 pub mod params;
+pub mod rayleigh;
 pub mod solver;
 
 pub use crate::model::friction::FrictionLaw;
 pub use energy::EnergyTerms;
 pub use params::{ContactEnforcement, Integrator, SolverParams};
+pub use rayleigh::RayleighDamping;
 pub use solver::{Dda, Modes, RunCounters, StepReport};

@@ -10,7 +10,7 @@ use crate::analytic::{ExactOptions, ShearBuilding, simulate};
 use crate::dda::{Dda, FrictionLaw, Integrator, SolverParams};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::Scene;
-use crate::model::scene::{ExcitationDef, StructureRoles};
+use crate::model::scene::ExcitationDef;
 use crate::post::history::History;
 use crate::post::spectrum::{UniformSeries, fourier_amplitude, resample_uniform};
 use crate::setup::{ModelKind, RunSetup, RunSpec};
@@ -19,83 +19,7 @@ use crate::{Error, Result};
 /// The paper's natural frequencies of its three-storey frame, Hz.
 pub const PAPER_FREQUENCIES_HZ: [f64; 3] = [0.638, 1.788, 2.583];
 
-/// The structure roles of a scene, or an error naming the scene.
-pub fn roles(scene: &Scene) -> Result<StructureRoles> {
-    scene.structure.clone().ok_or_else(|| {
-        Error::invalid(
-            "--scene",
-            format!(
-                "scene '{}' is not a building scene (no [structure] section)",
-                scene.name
-            ),
-        )
-    })
-}
-
-/// Natural frequencies and floor mode shapes of a building's fixed-base frame.
-#[derive(Debug, Clone, Serialize)]
-pub struct ModesReport {
-    /// Scene name.
-    pub scene: String,
-    /// The lowest sway frequencies, Hz (as many as there are floors).
-    pub frequencies_hz: Vec<f64>,
-    /// Per mode: horizontal displacement of the base and each floor, normalised so that the
-    /// largest is 1 (roof positive).
-    pub shapes: Vec<Vec<f64>>,
-    /// Names of the base and floors, in the order of the shapes.
-    pub levels: Vec<String>,
-    /// For the equivalent MDOF model ([`equivalent_mdof`]): the largest relative
-    /// difference between its frequencies and the DDA frame's (0 up to rounding for
-    /// frames that behave as shear buildings, like the paper's; larger for tall frames,
-    /// whose overall bending no shear building has).
-    pub mdof_fit_error: Option<f64>,
-}
-
-/// Modal analysis of a building scene from the DDA stiffness and mass (fixed base: the
-/// sliding joint's springs held stuck).
-pub fn modes(scene: &Scene) -> Result<ModesReport> {
-    let r = roles(scene)?;
-    let dda = Dda::new(scene, None, SolverParams::default())?;
-    let modes = dda.modes()?;
-    let levels: Vec<String> = std::iter::once(r.base.clone())
-        .chain(r.floors.iter().cloned())
-        .collect();
-    let idx: Vec<usize> = levels
-        .iter()
-        .map(|n| dda.block_index(n))
-        .collect::<Result<_>>()?;
-    let mut frequencies_hz = Vec::new();
-    let mut shapes = Vec::new();
-    // Sway modes: the floors move horizontally as slabs (rather than a column or the base
-    // slab vibrating on its own).
-    for (f, shape) in modes.frequencies_hz.iter().zip(&modes.shapes) {
-        if frequencies_hz.len() == r.floors.len() {
-            break;
-        }
-        let u: Vec<f64> = idx.iter().map(|&b| shape[b][0]).collect();
-        let floor_energy: f64 = u.iter().map(|x| x * x).sum();
-        let total: f64 = shape
-            .iter()
-            .map(|d| d.iter().map(|x| x * x).sum::<f64>())
-            .sum();
-        if floor_energy < 0.05 * total {
-            continue;
-        }
-        let peak = u
-            .iter()
-            .fold(0.0_f64, |m, x| if x.abs() > m.abs() { *x } else { m });
-        let sign = if u[u.len() - 1] < 0.0 { -1.0 } else { 1.0 };
-        shapes.push(u.iter().map(|x| sign * x / peak.abs()).collect());
-        frequencies_hz.push(*f);
-    }
-    Ok(ModesReport {
-        scene: scene.name.clone(),
-        frequencies_hz,
-        shapes,
-        levels,
-        mdof_fit_error: None,
-    })
-}
+pub use crate::setup::modes::{ModesReport, modes, roles};
 
 /// Summary of a building run (the JSON object of `run --json`). A quantity that is
 /// undefined for the run is left out (never `null`), and `warnings` says why.
@@ -113,6 +37,9 @@ pub struct FrameSummary {
     /// The vertical ground motion (record name), when the ground also shakes vertically.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vertical_record: Option<String>,
+    /// The bearing under the base slab, `pendulum:R`, when it is not the flat joint.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bearing: Option<String>,
     /// Friction coefficient (absent for a fixed base).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
@@ -245,6 +172,7 @@ fn summarise(
         integrator: (model == ModelKind::Dda).then(|| setup.integrator.label()),
         record: setup.motion.label(),
         vertical_record: setup.vertical.as_ref().map(|v| v.label()),
+        bearing: setup.bearing_radius.map(|r| format!("pendulum:{r}")),
         friction: super::run::reported_friction(setup, &mut warnings),
         fixed_base: setup.fixed_base,
         duration_s: setup.duration,
@@ -490,13 +418,12 @@ fn run_mdof_setup(setup: &RunSetup) -> Result<FrameOutcome> {
     let output_dt = simulate::exact_output_dt(MDOF_OUTPUT_DT, setup.duration);
     let keep = setup.history.stride() > 0;
     let (run, raft_accel) = if setup.needs_stepped_exact() {
-        let n = building.storey_masses.len();
-        let structure = building.sliding_structure(
-            setup.joint_law(),
-            nalgebra::DMatrix::zeros(n, n),
-            motion,
-            setup.vertical.as_ref(),
-        );
+        let damping = building.rayleigh_damping(setup.damping_ratio)?;
+        let mut structure =
+            building.sliding_structure(setup.joint_law(), damping, motion, setup.vertical.as_ref());
+        if let Some(radius) = setup.bearing_radius {
+            structure.surface = crate::analytic::Surface::Linearised { radius };
+        }
         let options = crate::analytic::SteppedOptions::default();
         let r = crate::analytic::simulate_stepped(&structure, setup.duration, output_dt, &options)?;
         let run = simulate::stepped_model_run(&r, motion, setup.duration, keep, 1.0, start);

@@ -1,5 +1,6 @@
 //! Scenes as data: geometry, materials, the scene description and the built-in presets.
 
+pub mod bearing;
 pub mod friction;
 pub mod generated;
 pub mod geometry;

@@ -94,6 +94,41 @@ pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
     Ok(())
 }
 
+/// Structural damping applies to a two-block scene (the dashpot beside its spring) and to
+/// a building whose structure is one elastic body, its blocks joined by connection
+/// elements or bolts (Rayleigh damping). A structure of blocks in contact (a masonry wall)
+/// is refused: Rayleigh's mass-proportional part would damp the blocks' sliding and
+/// rocking on each other, which is friction's to dissipate.
+fn check_damping_applies(scene: &Scene) -> Result<()> {
+    if scene.two_block.is_some() {
+        return Ok(());
+    }
+    let Some(roles) = &scene.structure else {
+        return Err(Error::invalid(
+            "--damping",
+            format!(
+                "structural damping applies to two-block scenes (a dashpot beside the \
+                 spring) and building scenes (Rayleigh damping of the frame); '{}' is \
+                 neither (a rigid block has no structure to damp)",
+                scene.name
+            ),
+        ));
+    };
+    if let Some(c) = scene.contacts.iter().find(|c| c.name != roles.joint) {
+        return Err(Error::invalid(
+            "--damping",
+            format!(
+                "Rayleigh damping needs a structure that is one elastic body (blocks joined \
+                 by connection elements, as the frame scenes are); '{}' has blocks in \
+                 contact (contact '{}'), whose sliding and rocking on each other the \
+                 damping would resist",
+                scene.name, c.name
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Options that do not apply to this scene and model: refused, with what would apply.
 pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
     let exact = spec.model == ModelKind::MassSpring;
@@ -112,17 +147,18 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
     }
     if let Some(zeta) = spec.damping {
         crate::error::require_range("--damping", zeta, 0.0, 0.99, "(the damping ratio ζ)")?;
-        if scene.two_block.is_none() {
-            return Err(Error::invalid(
-                "--damping",
-                format!(
-                    "structural damping is built for two-block scenes (a dashpot beside \
-                     the structure's spring); '{}' is not one, and the Rayleigh damping of \
-                     building scenes is not there yet",
-                    scene.name
-                ),
-            ));
-        }
+        check_damping_applies(scene)?;
+    }
+    if spec.bearing.and_then(|b| b.radius()).is_some() && scene.structure.is_none() {
+        return Err(Error::invalid(
+            "--bearing",
+            format!(
+                "pendulum bearings go under a frame's base slab (three-storey, frame:N); \
+                 '{}' is not a frame (for a lone slider on a dish, run --scene \
+                 friction-pendulum)",
+                scene.name
+            ),
+        ));
     }
     if spec.fixed_base && spec.friction.is_some() {
         return Err(Error::invalid(

@@ -10,6 +10,7 @@
 
 mod check;
 pub mod defaults;
+pub mod modes;
 mod prepare;
 pub mod response;
 mod spec;

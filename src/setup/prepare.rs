@@ -7,9 +7,10 @@ use super::response::Probe;
 use super::spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 use super::{check, defaults};
 use crate::analytic::{ShearBuilding, SlidingBlock, SlidingStructure, Surface};
-use crate::dda::{Dda, Integrator, SolverParams};
+use crate::dda::{Dda, Integrator, RayleighDamping, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, resolve_record};
 use crate::model::Scene;
+use crate::model::bearing::apply_pendulum_bearings;
 use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground};
 use crate::model::scene::{ExcitationDef, SlidingBlockRoles, StructureRoles, TwoBlockRoles};
@@ -67,6 +68,13 @@ pub struct RunSetup {
     pub fixed_base: bool,
     /// Structural damping ratio ζ (0: undamped).
     pub damping_ratio: f64,
+    /// A building's Rayleigh damping (ratio ζ at its first two fixed-base sway modes);
+    /// `None` for undamped runs and other scenes (a two-block scene's damping is the
+    /// dashpot beside its spring).
+    pub rayleigh: Option<RayleighDamping>,
+    /// The effective radius of a frame's friction-pendulum bearings (`None`: the flat
+    /// joint); the exact MDOF model then has the linearised bearing's restoring force.
+    pub bearing_radius: Option<f64>,
     /// `harmonic` or the record's name.
     pub excitation_label: String,
     /// Factor applied to the ground motion to reach [`RunSpec::pga_g`] (1: as given).
@@ -260,6 +268,8 @@ impl RunSpec {
             friction,
             fixed_base: self.fixed_base,
             damping_ratio: self.damping.unwrap_or(0.0),
+            rayleigh: None,
+            bearing_radius: None,
             excitation_label,
             motion_scale: 1.0,
             warnings: Vec::new(),
@@ -269,6 +279,11 @@ impl RunSpec {
 
     /// A building: friction, fixed base and excitation set on the scene as it is.
     fn building(&self, mut scene: Scene, roles: StructureRoles) -> Result<RunSetup> {
+        let bearing_radius = self.bearing.and_then(|b| b.radius());
+        if let Some(radius) = bearing_radius {
+            let ground = scene.ground.block.clone();
+            apply_pendulum_bearings(&mut scene, &ground, &roles.base, radius)?;
+        }
         if let Some(law) = self.law_given() {
             set_joint_law(&mut scene, &roles.joint, law);
         }
@@ -281,14 +296,21 @@ impl RunSpec {
         let roof = roles.floors.last().unwrap_or(&roles.base).clone();
         let blocks = [roles.base.clone(), roof, roles.joint.clone()];
         let label = motion.label();
-        Ok(self.setup(
+        let rayleigh = match self.damping {
+            Some(zeta) if zeta > 0.0 => Some(super::modes::rayleigh_damping(&scene, zeta)?),
+            _ => None,
+        };
+        let mut setup = self.setup(
             scene,
             motion,
             SceneRoles::Building(roles),
             blocks,
             friction,
             label,
-        ))
+        );
+        setup.rayleigh = rayleigh;
+        setup.bearing_radius = bearing_radius;
+        Ok(setup)
     }
 
     /// The vertical ground motion: the specification's, or the scene's.
@@ -436,6 +458,9 @@ impl RunSetup {
     pub fn build_dda(&self, scene: &Scene, params: SolverParams) -> Result<(Dda, Probe)> {
         let mut dda = Dda::new(scene, Some(self.motion.clone()), params)?;
         dda.set_vertical_motion(self.vertical.clone())?;
+        if let Some(damping) = self.rayleigh {
+            dda.set_rayleigh_damping(damping, &self.base)?;
+        }
         let probe = Probe {
             base: dda.block_index(&self.base)?,
             roof: dda.block_index(&self.roof)?,
@@ -462,6 +487,7 @@ impl RunSetup {
         !matches!(self.joint_law(), Friction::Coulomb(_))
             || self.vertical.is_some()
             || self.damping_ratio > 0.0
+            || self.bearing_radius.is_some()
     }
 
     /// The rigid sliding block of a `block` run (its exact model's input).

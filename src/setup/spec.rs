@@ -172,9 +172,12 @@ pub struct RunSpec {
     pub friction_law: Option<Friction>,
     /// Fix the base: the sliding joint is bonded and never slides.
     pub fixed_base: bool,
-    /// Structural damping ratio ζ (two-block scenes: a dashpot c = 2ζ√(k m) in parallel
-    /// with the structure's spring, in DDA and in the exact model alike; default 0).
+    /// Structural damping ratio ζ, in DDA and in the exact model alike (default 0):
+    /// two-block scenes get a dashpot c = 2ζ√(k m) in parallel with the structure's
+    /// spring, frames Rayleigh damping with ratio ζ at their first two fixed-base modes.
     pub damping: Option<f64>,
+    /// The bearing under a frame's base slab (default: the scene's flat joint).
+    pub bearing: Option<crate::model::bearing::Bearing>,
     /// Scale the ground motion to this peak ground acceleration over the run, g (default:
     /// as given).
     pub pga_g: Option<f64>,

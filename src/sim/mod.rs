@@ -64,7 +64,7 @@ pub struct SimConfig {
     pub duration: Option<f64>,
     /// Simulated time between published frames, s.
     pub frame_dt: f64,
-    /// Structural damping ratio ζ (two-block scenes; None: undamped).
+    /// Structural damping ratio ζ (two-block and frame scenes; None: undamped).
     pub damping: Option<f64>,
     /// Vertical ground motion: a built-in `-up` record or a file (None: horizontal only).
     pub vertical: Option<String>,

@@ -86,13 +86,21 @@ impl AppState {
         if self.controls.scene == SceneChoice::TwoBlock {
             ui.add(egui::Slider::new(&mut self.controls.alpha, 0.05..=0.95).text("mass ratio α"))
                 .on_hover_text("the structure's share of the total mass: α = m / (M + m)");
+        }
+        if self.controls.damping_applies() {
+            let how = if self.controls.scene == SceneChoice::TwoBlock {
+                "a dashpot beside the spring, ζ of critical. The exact solution drawn dashed \
+                 is damped alike"
+            } else {
+                "Rayleigh damping of the frame, ζ of critical at its first two sway modes, \
+                 acting on the floors' motion relative to the base slab"
+            };
             let r = ui
                 .add(egui::Slider::new(&mut self.controls.damping, 0.0..=0.2).text("damping ζ"))
-                .on_hover_text(
-                    "structural damping: a dashpot beside the spring, ζ of critical (0.02 to \
-                     0.05 is typical of buildings); the sliding itself is never damped. The \
-                     exact solution drawn dashed is damped alike",
-                );
+                .on_hover_text(format!(
+                    "structural damping: {how} (0.02 to 0.05 is typical of buildings); the \
+                     sliding itself is never damped"
+                ));
             self.widget_rects.insert("damping", r.rect);
         }
     }

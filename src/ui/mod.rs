@@ -119,7 +119,7 @@ pub struct Controls {
     pub dt: f64,
     /// What runs beside the model.
     pub comparison: Comparison,
-    /// Structural damping ratio ζ (two-block scene; 0: undamped).
+    /// Structural damping ratio ζ (two-block and frame scenes; 0: undamped).
     pub damping: f64,
     /// Shake the ground vertically too, with the record's own vertical component
     /// ([`VERTICAL_RECORD`]; El Centro records only).
@@ -156,6 +156,15 @@ impl Controls {
             if n.starts_with("el-centro") && !n.ends_with("-up"))
     }
 
+    /// Whether the damping slider applies: the two-block scene (a dashpot beside its
+    /// spring) and the frames (Rayleigh damping); not a wall of loose blocks.
+    pub fn damping_applies(&self) -> bool {
+        matches!(
+            self.scene,
+            SceneChoice::TwoBlock | SceneChoice::ThreeStorey | SceneChoice::Frame(_)
+        )
+    }
+
     /// The simulation configuration these controls describe.
     pub fn config(&self) -> SimConfig {
         let two_block = self.scene == SceneChoice::TwoBlock;
@@ -186,7 +195,7 @@ impl Controls {
                 _ => self.pga_g,
             },
             duration: None,
-            damping: (two_block && self.damping > 0.0).then_some(self.damping),
+            damping: (self.damping_applies() && self.damping > 0.0).then_some(self.damping),
             vertical: (self.vertical && self.vertical_available())
                 .then(|| VERTICAL_RECORD.to_string()),
             ..SimConfig::default()

@@ -2,6 +2,7 @@
 //! the submodules, one job each.
 
 mod analysis;
+mod damping;
 mod events;
 mod iteration;
 mod ledger;
@@ -167,6 +168,8 @@ pub struct Dda {
     motion: Option<GroundMotion>,
     /// The vertical ground motion (up positive), if the ground also shakes vertically.
     vertical: Option<GroundMotion>,
+    /// Rayleigh damping of the structure and its base slab's block index.
+    rayleigh: Option<(super::rayleigh::RayleighDamping, usize)>,
     gravity: f64,
     params: SolverParams,
     coeffs: AlphaCoefficients,
@@ -398,11 +401,9 @@ impl Dda {
             &bolts,
             &fixed,
             &connections,
+            None,
         ));
-        let linear = LinearSolver::new(Arc::clone(&pattern)).map_err(|e| Error::Solver {
-            time: 0.0,
-            reason: format!("cannot analyse the system matrix: {e:?}"),
-        })?;
+        let linear = analysed(&pattern)?;
         let mut model = Self {
             blocks,
             ground,
@@ -421,6 +422,7 @@ impl Dda {
             loads,
             motion,
             vertical: None,
+            rayleigh: None,
             gravity: scene.gravity,
             coeffs: params.integrator.coefficients(),
             dt_current: params.dt,
@@ -791,14 +793,25 @@ fn spread_force(dofs: &DofMap, rhs: &mut [f64], amount: f64, sides: [(usize, &Ve
     }
 }
 
-/// The block couplings the system matrix can have: joints between their blocks, and each
-/// declared contact pair (the only blocks contacts are searched between).
+/// The linear solver's analysis of a pattern (symbolic once, numeric every pass).
+fn analysed(pattern: &Arc<BlockPattern>) -> Result<LinearSolver> {
+    LinearSolver::new(Arc::clone(pattern)).map_err(|e| Error::Solver {
+        time: 0.0,
+        reason: format!("cannot analyse the system matrix: {e:?}"),
+    })
+}
+
+/// The block couplings the system matrix can have: joints between their blocks, each
+/// declared contact pair (the only blocks contacts are searched between) and, with
+/// Rayleigh damping on the structure over the block `damped_base`, that block with every
+/// free block (the mass-proportional dashpots).
 fn coupling_pattern(
     dofs: &DofMap,
     pairs: &[ContactPair],
     bolts: &[Bolt],
     fixed: &[FixedPoint],
     connections: &[Connection],
+    damped_base: Option<usize>,
 ) -> BlockPattern {
     let free = |b: usize| dofs.slot[b].map(|s| s / 6);
     let mut couplings = Vec::new();
@@ -822,6 +835,11 @@ fn coupling_pattern(
     }
     for c in connections {
         tie(&c.blocks);
+    }
+    if let Some(base) = damped_base {
+        for b in 0..dofs.slot.len() {
+            tie(&[base, b]);
+        }
     }
     BlockPattern::new(dofs.n / 6, couplings)
 }

@@ -449,14 +449,8 @@ impl Dda {
                 damped += force * (dot6(a, &increments[i]) + dot6(b, &increments[j]));
             }
         }
-        // The structure's dashpots (bolts), the same way, booked apart from the joints'.
-        let mut structural = 0.0;
-        for (damping, i, a, j, b) in self.bolt_dashpot_rows() {
-            let q0 = self.directional_velocity(i, &a, j, &b, &|k| start[k][0]);
-            let q1 = self.directional_velocity(i, &a, j, &b, &|k| self.blocks[k].velocity);
-            let force = damping * 0.5 * (q0 + q1);
-            structural += force * (dot6(&a, &increments[i]) + dot6(&b, &increments[j]));
-        }
+        // The structure's damping, the same way, booked apart from the joints'.
+        let structural = self.structural_damping_work(&start, increments);
         // Work of the loads: gravity and point loads, and the ground's acceleration, which
         // in the frame moving with the ground is a body force −m ü0 on every block (but
         // the paper's large-mass ground, whose driving force m_g ü0 cancels it).

@@ -91,9 +91,7 @@ impl Dda {
             sys.add_nodal_element(&self.dofs, known, &centroids, e);
         }
         if let Mode::Dynamic { dt } = mode {
-            for (damping, i, a, j, b) in self.bolt_dashpot_rows() {
-                self.add_dashpot(sys, damping, (i, &a), (j, &b), dt);
-            }
+            self.add_structural_damping(sys, elements, dt);
         }
         for l in &self.loads {
             if let Some(s) = self.dofs.slot[l.block] {
@@ -195,23 +193,6 @@ impl Dda {
         for (damping, a, b) in [(cn, &c.gap_i, &c.gap_j), (cs, &c.slip_i, &c.slip_j)] {
             self.add_dashpot(sys, damping, (i, a), (j, b), dt);
         }
-    }
-
-    /// The bolts' dashpots, one row per direction: (coefficient, block i and the map of
-    /// its unknowns to the relative velocity, block j and its map). The relative velocity
-    /// q = e·(v_Q − v_P) of the bolt's ends along direction e, at the step start.
-    pub(super) fn bolt_dashpot_rows(&self) -> Vec<(f64, usize, Vec6, usize, Vec6)> {
-        let centroids = self.centroids();
-        let mut rows = Vec::new();
-        for bolt in &self.bolts {
-            let [i, j] = bolt.blocks;
-            for e in bolt.dashpot_directions() {
-                let a = t_transpose_times(centroids[i], bolt.points[0], [-e[0], -e[1]]);
-                let b = t_transpose_times(centroids[j], bolt.points[1], e);
-                rows.push((bolt.damping, i, a, j, b));
-            }
-        }
-        rows
     }
 
     /// Adds a dashpot of coefficient `damping` on the relative velocity q = a·v_i + b·v_j:
