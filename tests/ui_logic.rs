@@ -465,3 +465,49 @@ fn the_frames_offer_rayleigh_damping_and_the_wall_does_not() {
     let h = harness(AppState::new(wall), 1600.0, 900.0);
     assert!(h.query_all_by_label_contains("damping ζ").next().is_none());
 }
+
+/// Issue 15: the preset "friction pendulum against flat slider" runs the frame on
+/// pendulum bearings beside the same frame on the flat joint; the two models set up with
+/// their own grounds (dishes, flat) and labels that say which is which. Unticking the
+/// bearings takes the flat-joint comparison away.
+#[test]
+fn the_pendulum_preset_runs_the_frame_on_both_bearings() {
+    let mut h = harness(with_run(1.0), 1600.0, 900.0);
+    h.get_by_value("lecture presets…").click();
+    h.run_steps(2);
+    h.get_by_label("Friction pendulum against flat slider: recentring")
+        .click();
+    h.run_steps(2);
+    let r = runs(&h.state_mut().take_commands());
+    let last = r.last().expect("the preset starts a run").clone();
+    assert_eq!(
+        last.bearing,
+        Some(slidebase::model::bearing::Bearing::Pendulum { radius: 2.0 })
+    );
+    assert!(last.compare_flat && !last.compare_fixed);
+    let run = slidebase::sim::prepare(&last).expect("both models set up");
+    assert_eq!(run.labels.len(), 2, "{:?}", run.labels);
+    assert!(
+        run.labels[0].starts_with("pendulum bearings R = 2 m"),
+        "{:?}",
+        run.labels
+    );
+    assert!(run.labels[1].starts_with("flat joint"), "{:?}", run.labels);
+    let ground_vertices = |k: usize| {
+        run.models[k].0.blocks()[run.models[k].0.ground()]
+            .vertices
+            .len()
+    };
+    assert!(
+        ground_vertices(0) > 900,
+        "the pendulum's ground has its dishes"
+    );
+    assert_eq!(ground_vertices(1), 4, "the flat joint's ground is a slab");
+    // The bearing checkbox is there for the frame; unticking it drops the comparison.
+    h.get_by_label("friction-pendulum bearings").click();
+    h.run_steps(2);
+    let r = runs(&h.state_mut().take_commands());
+    let last = r.last().expect("unticking restarts the run");
+    assert_eq!(last.bearing, None);
+    assert!(!last.compare_flat && last.compare_fixed);
+}

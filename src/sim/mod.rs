@@ -19,6 +19,7 @@ use crate::analytic::{ExactOptions, ShearBuilding, SteppedOptions, simulate, sim
 use crate::dda::{Dda, Integrator};
 use crate::ground_motion::GroundMotion;
 use crate::model::Scene;
+use crate::model::bearing::Bearing;
 use crate::setup::{ExcitationSpec, Frequency, RunSetup, RunSpec, VerticalSpec};
 
 /// The ground motion of a run.
@@ -68,6 +69,11 @@ pub struct SimConfig {
     pub damping: Option<f64>,
     /// Vertical ground motion: a built-in `-up` record or a file (None: horizontal only).
     pub vertical: Option<String>,
+    /// The bearing under a frame's base slab (None: the scene's flat joint).
+    pub bearing: Option<Bearing>,
+    /// With pendulum bearings: also run the same frame on the flat joint, second from the
+    /// left (the recentring comparison).
+    pub compare_flat: bool,
 }
 
 impl Default for SimConfig {
@@ -88,6 +94,8 @@ impl Default for SimConfig {
             frame_dt: 0.01,
             damping: None,
             vertical: None,
+            bearing: None,
+            compare_flat: false,
         }
     }
 }
@@ -200,6 +208,7 @@ impl SimConfig {
             integrator: Some(self.integrator),
             pga_g: self.pga_g,
             damping: self.damping,
+            bearing: self.bearing,
             vertical: self.vertical.as_ref().map(|source| VerticalSpec {
                 source: source.clone(),
                 scale: 1.0,
@@ -217,7 +226,28 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
     let motion_info = MotionInfo::of(&setup.motion, setup.duration, setup.motion_scale);
     // The models: the main one, the friction comparisons, the fixed base; each a variant
     // of the one set-up's scene.
-    let mut scenes = vec![(setup.scene.clone(), sliding_label(setup.friction))];
+    let radius = setup.bearing_radius;
+    let main_label = match radius {
+        Some(r) => format!(
+            "pendulum bearings R = {} m, ρ = {}",
+            crate::post::format_number(r),
+            crate::post::format_number(setup.friction)
+        ),
+        None => sliding_label(setup.friction),
+    };
+    let mut scenes = vec![(setup.scene.clone(), main_label)];
+    if config.compare_flat && radius.is_some() {
+        let flat = RunSpec {
+            bearing: None,
+            ..config.spec()?
+        }
+        .prepare()?;
+        let label = format!(
+            "flat joint, ρ = {}",
+            crate::post::format_number(setup.friction)
+        );
+        scenes.push((flat.scene, label));
+    }
     for &f in &config.compare_friction {
         scenes.push((setup.friction_variant_scene(f)?, sliding_label(f)));
     }

@@ -103,6 +103,40 @@ impl AppState {
                 ));
             self.widget_rects.insert("damping", r.rect);
         }
+        if self.controls.bearing_applies() {
+            self.bearing_controls(ui);
+        }
+    }
+
+    /// The frame's bearings: the flat joint, or two friction pendulums of radius R.
+    fn bearing_controls(&mut self, ui: &mut egui::Ui) {
+        let mut pendulum = self.controls.bearing_radius.is_some();
+        let r = ui
+            .checkbox(&mut pendulum, "friction-pendulum bearings")
+            .on_hover_text(
+                "stand the base slab on two friction pendulums instead of the flat joint: \
+                 pointed feet sliding in concave dishes. Gravity pulls the building back \
+                 to the middle, so it does not stay where an earthquake left it",
+            );
+        self.widget_rects.insert("bearing", r.rect);
+        if pendulum != self.controls.bearing_radius.is_some() {
+            self.controls.bearing_radius =
+                pendulum.then_some(crate::model::bearing::DEFAULT_RADIUS_M);
+            if !pendulum && self.controls.comparison == Comparison::FlatJoint {
+                self.controls.comparison = Comparison::FixedBase;
+            }
+        }
+        if let Some(radius) = &mut self.controls.bearing_radius {
+            ui.add(
+                egui::Slider::new(radius, 0.5..=10.0)
+                    .logarithmic(true)
+                    .text("dish radius R (m)"),
+            )
+            .on_hover_text(
+                "the bearings' effective radius: the building swings like a pendulum of \
+                 this length, period 2π√(R/g) (2.8 s at 2 m); larger R, weaker recentring",
+            );
+        }
     }
 
     fn section_ground(&mut self, ui: &mut egui::Ui) {
@@ -236,15 +270,23 @@ impl AppState {
 
     fn section_compare(&mut self, ui: &mut egui::Ui) {
         ui.strong("compare with");
+        let pendulum = self.controls.bearing().is_some();
         let c = &mut self.controls.comparison;
         let kind = match c {
             Comparison::None => 0,
             Comparison::FixedBase => 1,
             Comparison::Friction(_) => 2,
             Comparison::FrictionAndFixed(_) => 3,
+            Comparison::FlatJoint => 4,
         };
         let mut choice = kind;
         ui.horizontal_wrapped(|ui| {
+            if pendulum {
+                ui.radio_value(&mut choice, 4, "flat joint").on_hover_text(
+                    "the same frame on the flat sliding joint, same friction: it slides as \
+                     far but stays where the earthquake leaves it",
+                );
+            }
             ui.radio_value(&mut choice, 1, "fixed base").on_hover_text(
                 "the same structure with its base fixed to the ground: what isolation saves",
             );
@@ -261,6 +303,7 @@ impl AppState {
             *c = match choice {
                 0 => Comparison::None,
                 1 => Comparison::FixedBase,
+                4 => Comparison::FlatJoint,
                 _ => Comparison::Friction(others.clone()),
             };
         }

@@ -18,6 +18,7 @@ mod timeline;
 use std::time::Instant;
 
 use crate::dda::Integrator;
+use crate::model::bearing::Bearing;
 use crate::render::{Camera, ColorBy, Fit, Layers};
 use crate::sim::{
     ExactOverlay, Excitation, FrameSet, MotionInfo, Samples, SimCommand, SimConfig, SimMessage,
@@ -93,6 +94,8 @@ pub enum Comparison {
     Friction(Vec<f64>),
     /// Other friction coefficients and the fixed base.
     FrictionAndFixed(Vec<f64>),
+    /// The same frame on the flat joint (when it stands on pendulum bearings).
+    FlatJoint,
 }
 
 /// What the user has set in the panel: the physics of a run. Any change restarts the run
@@ -124,6 +127,9 @@ pub struct Controls {
     /// Shake the ground vertically too, with the record's own vertical component
     /// ([`VERTICAL_RECORD`]; El Centro records only).
     pub vertical: bool,
+    /// Effective radius of the frame's friction-pendulum bearings, m (None: the flat
+    /// joint; frames only).
+    pub bearing_radius: Option<f64>,
 }
 
 /// The vertical component the "vertical shaking" toggle adds (the only built-in one).
@@ -144,6 +150,7 @@ impl Default for Controls {
             comparison: Comparison::FixedBase,
             damping: 0.0,
             vertical: false,
+            bearing_radius: None,
         }
     }
 }
@@ -165,6 +172,19 @@ impl Controls {
         )
     }
 
+    /// Whether the bearing choice applies: the frames (their base slab can stand on
+    /// friction-pendulum bearings).
+    pub fn bearing_applies(&self) -> bool {
+        matches!(self.scene, SceneChoice::ThreeStorey | SceneChoice::Frame(_))
+    }
+
+    /// The frame's bearings as run (None: the flat joint).
+    pub fn bearing(&self) -> Option<Bearing> {
+        self.bearing_radius
+            .filter(|_| self.bearing_applies())
+            .map(|radius| Bearing::Pendulum { radius })
+    }
+
     /// The simulation configuration these controls describe.
     pub fn config(&self) -> SimConfig {
         let two_block = self.scene == SceneChoice::TwoBlock;
@@ -173,7 +193,9 @@ impl Controls {
             Comparison::FixedBase => (Vec::new(), true),
             Comparison::Friction(f) => (f.clone(), false),
             Comparison::FrictionAndFixed(f) => (f.clone(), true),
+            Comparison::FlatJoint => (Vec::new(), false),
         };
+        let bearing = self.bearing();
         SimConfig {
             scene: self.scene.name(),
             friction: Some(self.friction),
@@ -198,6 +220,8 @@ impl Controls {
             damping: (self.damping_applies() && self.damping > 0.0).then_some(self.damping),
             vertical: (self.vertical && self.vertical_available())
                 .then(|| VERTICAL_RECORD.to_string()),
+            bearing,
+            compare_flat: bearing.is_some() && self.comparison == Comparison::FlatJoint,
             ..SimConfig::default()
         }
     }

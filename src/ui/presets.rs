@@ -33,6 +33,18 @@ pub fn presets() -> Vec<Preset> {
             },
         },
         Preset {
+            name: "Friction pendulum against flat slider: recentring",
+            point: "the frame on two friction-pendulum bearings (R = 2 m) beside the same frame \
+                    on the flat joint, ρ = 0.01, El Centro: both slide about 20 cm, but the flat \
+                    one stays 15 cm off while gravity in the dishes brings the other back to \
+                    the middle (at the price of more sway: the dishes push back)",
+            controls: Controls {
+                bearing_radius: Some(2.0),
+                comparison: Comparison::FlatJoint,
+                ..el_centro.clone()
+            },
+        },
+        Preset {
             name: "Resonance: harmonic ground motion at Ω/ω = 1",
             point: "the two-mass model shaken at its own frequency: the fixed base grows without \
                     bound, the sliding base caps the force at ρ × weight",
