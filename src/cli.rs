@@ -798,7 +798,10 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     let outcome = block::run_block_setup(setup)?;
     if let Some(dir) = &args.out {
         let overlays = block::standard_overlays(setup)?;
-        list_written(block::write_outputs(&outcome, &overlays, dir)?, args.json)?;
+        list_written(
+            block::write_outputs(setup, &outcome, &overlays, dir)?,
+            args.json,
+        )?;
     }
     let s = &outcome.summary;
     if args.json {

@@ -202,3 +202,45 @@ fn lift_off_is_refused_by_the_exact_block_and_announced_by_dda() {
         setup.warnings
     );
 }
+
+/// The friction the DDA block carries while it slides follows the velocity law: at every
+/// sample sliding faster than 2 cm/s, with and without vertical shaking, F/N (the block's
+/// acceleration over g + a_v, as in `friction.png`) is −μ(v)·sgn v within 2 % of μ. The
+/// slip speed is a central difference over ±1 ms and the friction is taken at the
+/// integrator's α point, so 2 % allows μ'(v)·Δv for the differences in v (μ' ≤ 1 s/m here).
+#[test]
+fn the_dda_block_slides_on_the_velocity_law() {
+    use slidebase::dda::FrictionLaw;
+    use slidebase::headless::friction_figure::friction_loop;
+    let law: Friction = "velocity:0.05,0.1,20".parse().unwrap();
+    for vertical in [false, true] {
+        let spec = RunSpec {
+            friction_law: Some(law),
+            duration: Some(30.0),
+            history: slidebase::setup::HistoryPlan::EverySteps(1),
+            vertical: vertical.then(|| VerticalSpec {
+                source: "el-centro-up".into(),
+                scale: 1.0,
+            }),
+            ..RunSpec::scene("block")
+        };
+        let setup = spec.prepare().unwrap();
+        let outcome = slidebase::headless::block::run_block_setup(&setup).unwrap();
+        let (v, ratio) = friction_loop(&setup, &outcome.run);
+        let mut checked = 0;
+        let mut worst = 0.0_f64;
+        for (&v, &r) in v.iter().zip(&ratio).filter(|(v, _)| v.abs() > 0.02) {
+            let mu = law.sliding_coefficient(v);
+            worst = worst.max((r + mu * v.signum()).abs() / mu);
+            checked += 1;
+        }
+        assert!(
+            checked > 500,
+            "vertical {vertical}: {checked} sliding samples"
+        );
+        assert!(
+            worst < 0.02,
+            "vertical {vertical}: F/N off the law by {worst} of μ"
+        );
+    }
+}

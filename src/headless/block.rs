@@ -145,9 +145,11 @@ pub fn standard_overlays(setup: &RunSetup) -> Result<Vec<SlipOverlay>> {
     Ok(overlays)
 }
 
-/// Writes a sliding-block run's history, summary and figure into `dir` (all or nothing);
-/// the figure draws `overlays` over the run's slip.
+/// Writes a sliding-block run's history, summary and figures into `dir` (all or nothing):
+/// `history.png` draws `overlays` over the run's slip, `friction.png` (flat joints) the
+/// friction hysteresis, F/N against the slip speed, with the exact block's and the law's.
 pub fn write_outputs(
+    setup: &RunSetup,
     outcome: &BlockOutcome,
     overlays: &[SlipOverlay],
     dir: &std::path::Path,
@@ -157,6 +159,9 @@ pub fn write_outputs(
     staged.write_json("summary.json", &outcome.summary)?;
     if !outcome.run.history.is_empty() {
         history_figure(outcome, overlays).save_png(&staged.path("history.png"), 1400, 900)?;
+    }
+    if let Some(fig) = super::friction_figure::friction_figure(setup, outcome, overlays) {
+        fig.save_png(&staged.path("friction.png"), 1200, 900)?;
     }
     staged.commit()
 }

@@ -7,6 +7,7 @@ pub mod accuracy;
 pub mod bench;
 pub mod block;
 pub mod frame;
+pub mod friction_figure;
 pub mod report;
 pub mod run;
 pub mod simulate;
