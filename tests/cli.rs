@@ -101,7 +101,7 @@ fn block_scene_json_has_the_documented_keys() {
         assert_eq!(v["scene"], "block");
         assert_eq!(v["model"], model);
     }
-    run_with_out(&[
+    let dir = run_with_out(&[
         "run",
         "--scene",
         "block",
@@ -110,6 +110,10 @@ fn block_scene_json_has_the_documented_keys() {
         "--vertical-record",
         "el-centro-up",
     ]);
+    assert!(
+        dir.path().join("friction.png").exists(),
+        "a block run draws its friction hysteresis"
+    );
     let out = slidebase(&["run", "--scene", "block", "--alpha", "0.5"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--alpha"));
