@@ -406,7 +406,17 @@ fn the_vertical_toggle_adds_the_vertical_record() {
     let last = r.last().expect("the toggle restarts the run");
     assert_eq!(last.vertical.as_deref(), Some("el-centro-up"));
     assert_eq!(last.damping, None, "undamped unless the slider is moved");
-    slidebase::sim::prepare(last).expect("the vertical run sets up");
+    let run = slidebase::sim::prepare(last).expect("the vertical run sets up");
+    let (name, peak) = run
+        .motion_info
+        .vertical
+        .clone()
+        .expect("the header names it");
+    assert_eq!(name, "el-centro-up");
+    assert!(
+        (peak - 0.178).abs() < 0.01,
+        "El Centro's vertical peak: {peak} g"
+    );
     // A sine wave has no vertical component: the toggle does not apply.
     let mut controls = h.state().controls.clone();
     controls.record = slidebase::ui::RecordChoice::Harmonic;

@@ -60,6 +60,8 @@ pub struct Attached<const N: usize> {
 pub struct Probes {
     /// Ground acceleration, m/s².
     pub ground_accel: f64,
+    /// Vertical ground acceleration, m/s² (up positive; 0 without vertical shaking).
+    pub ground_vertical_accel: f64,
     /// Ground displacement, m.
     pub ground_disp: f64,
     /// Absolute base acceleration, m/s².
@@ -106,6 +108,8 @@ pub struct Samples {
     pub time: Vec<f64>,
     /// Ground acceleration, m/s².
     pub ground_accel: Vec<f64>,
+    /// Vertical ground acceleration, m/s² (up positive; 0 without vertical shaking).
+    pub ground_vertical_accel: Vec<f64>,
     /// Absolute base acceleration, m/s².
     pub base_accel: Vec<f64>,
     /// Absolute roof acceleration, m/s².
@@ -131,6 +135,8 @@ impl Samples {
     pub fn append(&mut self, other: &mut Samples) {
         self.time.append(&mut other.time);
         self.ground_accel.append(&mut other.ground_accel);
+        self.ground_vertical_accel
+            .append(&mut other.ground_vertical_accel);
         self.base_accel.append(&mut other.base_accel);
         self.roof_accel.append(&mut other.roof_accel);
         self.slip.append(&mut other.slip);
@@ -145,6 +151,7 @@ impl Samples {
     fn push(&mut self, t: f64, p: &Probes) {
         self.time.push(t);
         self.ground_accel.push(p.ground_accel);
+        self.ground_vertical_accel.push(p.ground_vertical_accel);
         self.base_accel.push(p.base_accel);
         self.roof_accel.push(p.roof_accel);
         self.slip.push(p.slip);
@@ -297,6 +304,7 @@ impl Extractor {
         .measure(dda, motion);
         Probes {
             ground_accel: r.ground_accel,
+            ground_vertical_accel: dda.vertical_ground_accel(r.time),
             ground_disp: r.ground_disp,
             base_accel: r.base_accel,
             roof_accel: r.roof_accel,

@@ -137,10 +137,18 @@ pub struct MotionInfo {
     pub duration: Option<f64>,
     /// Factor applied to the record to reach the chosen PGA (1: as recorded).
     pub scale: f64,
+    /// The vertical component shaken with it, and its peak, g (None: horizontal only).
+    pub vertical: Option<(String, f64)>,
 }
 
 impl MotionInfo {
-    fn of(motion: &GroundMotion, duration: f64, scale: f64) -> Self {
+    fn of(
+        motion: &GroundMotion,
+        vertical: Option<&GroundMotion>,
+        duration: f64,
+        scale: f64,
+    ) -> Self {
+        let g = crate::ground_motion::STANDARD_GRAVITY;
         let (source, dt, length) = match motion {
             GroundMotion::Record(r) => (r.provenance.clone(), Some(r.dt), Some(r.duration())),
             _ => (String::new(), None, None),
@@ -148,10 +156,11 @@ impl MotionInfo {
         Self {
             name: motion.label(),
             source,
-            pga_g: motion.peak_accel(duration) / crate::ground_motion::STANDARD_GRAVITY,
+            pga_g: motion.peak_accel(duration) / g,
             dt,
             duration: length,
             scale,
+            vertical: vertical.map(|v| (v.label(), v.peak_accel(duration) / g)),
         }
     }
 }
@@ -223,7 +232,12 @@ impl SimConfig {
 pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
     let setup = config.spec()?.prepare()?;
     let exact = exact_overlay(&setup, config.frame_dt)?;
-    let motion_info = MotionInfo::of(&setup.motion, setup.duration, setup.motion_scale);
+    let motion_info = MotionInfo::of(
+        &setup.motion,
+        setup.vertical.as_ref(),
+        setup.duration,
+        setup.motion_scale,
+    );
     // The models: the main one, the friction comparisons, the fixed base; each a variant
     // of the one set-up's scene.
     let radius = setup.bearing_radius;

@@ -30,6 +30,8 @@ pub const MODEL_COLORS: [egui::Color32; 4] = [
 ];
 /// The exact solution (dashed).
 const EXACT: egui::Color32 = egui::Color32::from_rgb(230, 159, 0);
+/// The vertical ground acceleration (Okabe & Ito grey, apart from the models' colours).
+const VERTICAL_COLOR: egui::Color32 = egui::Color32::from_rgb(153, 153, 153);
 
 /// The colour of model `k`.
 pub fn model_color(k: usize) -> egui::Color32 {
@@ -140,6 +142,13 @@ impl PlotData {
             thin(&main.time[..n0], &main.ground_accel[..n0], 1.0 / G),
             None,
         ));
+        if main.ground_vertical_accel.iter().any(|&a| a != 0.0) {
+            d.accel.push(curve(
+                "ground, vertical".into(),
+                thin(&main.time[..n0], &main.ground_vertical_accel[..n0], 1.0 / G),
+                Some(VERTICAL_COLOR),
+            ));
+        }
         for (k, s) in timeline.samples.iter().enumerate() {
             let n = upto(s);
             let label = labels.get(k).cloned().unwrap_or_default();

@@ -499,11 +499,14 @@ pub fn inputs_of(state: &mut AppState) -> Option<SceneInputs> {
     }
     let (slip_ranges, slip_scale) = slip_extent(state, state.play_time);
     let motion = &state.timeline.motion;
-    let motion_text = if motion.scale != 1.0 {
+    let mut motion_text = if motion.scale != 1.0 {
         format!("{} scaled to PGA {:.2} g", motion.name, motion.pga_g)
     } else {
         format!("{} (PGA {:.2} g)", motion.name, motion.pga_g)
     };
+    if let Some((name, peak)) = &motion.vertical {
+        motion_text.push_str(&format!(" + vertical {name} ({peak:.2} g)"));
+    }
     Some(SceneInputs {
         frames,
         labels: state.timeline.labels.clone(),
