@@ -521,3 +521,50 @@ fn the_pendulum_preset_runs_the_frame_on_both_bearings() {
     assert_eq!(last.bearing, None);
     assert!(!last.compare_flat && last.compare_fixed);
 }
+
+/// Issue 15: the friction-law combo builds the law on the ρ slider (its coefficient at
+/// rest) and the run gets it instead of Coulomb's ρ; the sliding block and the friction
+/// pendulum are scenes of the panel, and set up.
+#[test]
+fn the_friction_law_and_the_block_scenes_are_in_the_panel() {
+    use slidebase::model::friction::Friction;
+    let mut h = harness(AppState::default(), 1600.0, 900.0);
+    h.state_mut().take_commands();
+    h.get_by_value("Coulomb (one ρ)").click();
+    h.run_steps(2);
+    h.get_by_label("velocity dependent").click();
+    h.run_steps(2);
+    let r = runs(&h.state_mut().take_commands());
+    let last = r.last().expect("a law change restarts the run");
+    assert_eq!(
+        last.friction_law,
+        Some(Friction::Velocity {
+            slow: 0.01,
+            fast: 0.02,
+            rate: 20.0
+        })
+    );
+    assert!(h.query_all_by_label_contains("μ_fast").next().is_some());
+    slidebase::sim::prepare(last).expect("the frame runs on the velocity law");
+    for scene in [
+        slidebase::ui::SceneChoice::Block,
+        slidebase::ui::SceneChoice::FrictionPendulum,
+    ] {
+        let controls = slidebase::ui::Controls {
+            scene: scene.clone(),
+            law: slidebase::ui::LawChoice::StaticKinetic { stick: 0.08 },
+            friction: 0.05,
+            ..Default::default()
+        };
+        let config = controls.config();
+        assert_eq!(
+            config.friction_law,
+            Some(Friction::StaticKinetic {
+                stick: 0.08,
+                slide: 0.05
+            })
+        );
+        let run = slidebase::sim::prepare(&config).expect("the scene sets up");
+        assert_eq!(run.models.len(), 2, "{scene:?} and its fixed base");
+    }
+}

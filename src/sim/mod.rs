@@ -45,6 +45,9 @@ pub struct SimConfig {
     pub scene: String,
     /// Friction coefficient of the sliding joint (None: the scene's).
     pub friction: Option<f64>,
+    /// Friction law of the sliding joint (None: Coulomb's with `friction`); replaces
+    /// `friction` when given.
+    pub friction_law: Option<crate::model::friction::Friction>,
     /// Mass ratio α (two-block scenes).
     pub alpha: Option<f64>,
     /// Ground motion.
@@ -81,6 +84,7 @@ impl Default for SimConfig {
         Self {
             scene: "three-storey".into(),
             friction: None,
+            friction_law: None,
             alpha: None,
             excitation: Excitation::Scene,
             integrator: Integrator::default(),
@@ -211,7 +215,12 @@ impl SimConfig {
             scene: scene.into(),
             excitation,
             alpha: self.alpha,
-            friction: self.friction,
+            friction: if self.friction_law.is_some() {
+                None
+            } else {
+                self.friction
+            },
+            friction_law: self.friction_law,
             duration: self.duration,
             dt: Some(self.dt),
             integrator: Some(self.integrator),

@@ -3,7 +3,7 @@
 //! run in the background and keeps the time cursor; typing a path restarts nothing until
 //! "load" is pressed.
 
-use super::{AppState, Comparison, Exaggeration, RecordChoice, SceneChoice};
+use super::{AppState, Comparison, Exaggeration, LawChoice, RecordChoice, SceneChoice};
 use crate::dda::Integrator;
 use crate::render::{ColorBy, Follow};
 
@@ -52,6 +52,10 @@ impl AppState {
                     .on_hover_text("the paper's frame: three storeys of slabs and columns on a base slab that can slide");
                 ui.selectable_value(c, SceneChoice::TwoBlock, SceneChoice::TwoBlock.label())
                     .on_hover_text("the paper's simplest model: a mass on a spring over a raft that can slide; its exact solution is drawn dashed in the plots");
+                ui.selectable_value(c, SceneChoice::Block, SceneChoice::Block.label())
+                    .on_hover_text("Newmark's sliding block: one rigid block on the joint, the textbook starting point; its exact solution is in the plots");
+                ui.selectable_value(c, SceneChoice::FrictionPendulum, SceneChoice::FrictionPendulum.label())
+                    .on_hover_text("a thin slider in a concave dish of radius 2 m: gravity pulls it back to the middle (period 2π√(R/g) = 2.8 s)");
                 let frame = if let SceneChoice::Frame(n) = c { *n } else { 5 };
                 ui.selectable_value(c, SceneChoice::Frame(frame), "frame of N storeys (generated)")
                     .on_hover_text("the paper's frame with any number of storeys");
@@ -83,6 +87,7 @@ impl AppState {
                  once the ground would have to push it harder than ρ × its weight",
             );
         self.widget_rects.insert("friction", r.rect);
+        self.law_controls(ui);
         if self.controls.scene == SceneChoice::TwoBlock {
             ui.add(egui::Slider::new(&mut self.controls.alpha, 0.05..=0.95).text("mass ratio α"))
                 .on_hover_text("the structure's share of the total mass: α = m / (M + m)");
@@ -105,6 +110,64 @@ impl AppState {
         }
         if self.controls.bearing_applies() {
             self.bearing_controls(ui);
+        }
+    }
+
+    /// The friction law of the joint, built on the ρ slider (its coefficient at rest).
+    fn law_controls(&mut self, ui: &mut egui::Ui) {
+        let law = &mut self.controls.law;
+        let rho = self.controls.friction;
+        let name = |l: &LawChoice| match l {
+            LawChoice::Coulomb => "Coulomb (one ρ)",
+            LawChoice::StaticKinetic { .. } => "static / kinetic",
+            LawChoice::Velocity { .. } => "velocity dependent",
+        };
+        let r = egui::ComboBox::from_id_salt("friction law")
+            .selected_text(name(law))
+            .width(COMBO_WIDTH)
+            .show_ui(ui, |ui| {
+                let coulomb = LawChoice::Coulomb;
+                ui.selectable_value(law, coulomb, name(&coulomb))
+                    .on_hover_text("the paper's law: the joint sticks up to ρ·N and slides against ρ·N");
+                let sk = LawChoice::StaticKinetic {
+                    stick: (1.6 * rho).min(1.0),
+                };
+                if !matches!(law, LawChoice::StaticKinetic { .. }) {
+                    ui.selectable_value(law, sk, name(&sk))
+                } else {
+                    ui.selectable_label(true, name(&sk))
+                }
+                .on_hover_text("sticks up to μ_s·N, then slides against the lower μ_k·N (μ_k is ρ): the base breaks loose with a jerk");
+                let v = LawChoice::Velocity {
+                    fast: (2.0 * rho).min(1.0),
+                    rate: 20.0,
+                };
+                if !matches!(law, LawChoice::Velocity { .. }) {
+                    ui.selectable_value(law, v, name(&v))
+                } else {
+                    ui.selectable_label(true, name(&v))
+                }
+                .on_hover_text("μ(v) = μ_fast − (μ_fast − ρ)·exp(−rate·|v|), as OpenSees' velocity-dependent friction of PTFE bearings: faster sliding, more friction");
+            })
+            .response
+            .on_hover_text("the friction law of the sliding joint; the ρ slider is its coefficient at rest");
+        self.widget_rects.insert("friction law", r.rect);
+        match &mut self.controls.law {
+            LawChoice::Coulomb => {}
+            LawChoice::StaticKinetic { stick } => {
+                ui.add(egui::Slider::new(stick, rho.max(0.001)..=1.0).logarithmic(true).text("static μ_s"))
+                    .on_hover_text("the coefficient the joint sticks up to; once it slides, ρ (the kinetic one) acts");
+            }
+            LawChoice::Velocity { fast, rate } => {
+                ui.add(
+                    egui::Slider::new(fast, rho.max(0.001)..=1.0)
+                        .logarithmic(true)
+                        .text("μ_fast"),
+                )
+                .on_hover_text("the coefficient at high slip speed");
+                ui.add(egui::Slider::new(rate, 1.0..=200.0).logarithmic(true).text("rate (s/m)"))
+                    .on_hover_text("how fast μ rises from ρ to μ_fast with the slip speed: at v = 1/rate it is 63 % of the way");
+            }
         }
     }
 

@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use crate::dda::Integrator;
 use crate::model::bearing::Bearing;
+use crate::model::friction::Friction;
 use crate::render::{Camera, ColorBy, Fit, Layers};
 use crate::sim::{
     ExactOverlay, Excitation, FrameSet, MotionInfo, Samples, SimCommand, SimConfig, SimMessage,
@@ -33,6 +34,10 @@ pub enum SceneChoice {
     ThreeStorey,
     /// The paper's two-mass model (Fig. 2).
     TwoBlock,
+    /// Newmark's sliding block: one rigid block on the joint (`block`).
+    Block,
+    /// A thin slider in a concave dish (`friction-pendulum`).
+    FrictionPendulum,
     /// The paper's frame with N storeys (`frame:N`).
     Frame(u32),
     /// A dry-stacked wall of N courses on a sliding slab (`wall:N`).
@@ -47,6 +52,8 @@ impl SceneChoice {
         match self {
             SceneChoice::ThreeStorey => "three-storey".into(),
             SceneChoice::TwoBlock => "two-block".into(),
+            SceneChoice::Block => "block".into(),
+            SceneChoice::FrictionPendulum => "friction-pendulum".into(),
             SceneChoice::Frame(n) => format!("frame:{n}"),
             SceneChoice::Wall(n) => format!("wall:{n}"),
             SceneChoice::File(p) => p.clone(),
@@ -58,6 +65,8 @@ impl SceneChoice {
         match self {
             SceneChoice::ThreeStorey => "three-storey frame (paper Fig. 3)".into(),
             SceneChoice::TwoBlock => "two-mass model (paper Fig. 2)".into(),
+            SceneChoice::Block => "sliding block (Newmark)".into(),
+            SceneChoice::FrictionPendulum => "friction pendulum (slider in a dish)".into(),
             SceneChoice::Frame(n) => format!("frame of {n} storeys"),
             SceneChoice::Wall(n) => format!("dry-stacked wall, {n} courses"),
             SceneChoice::File(p) => file_name(p),
@@ -130,6 +139,48 @@ pub struct Controls {
     /// Effective radius of the frame's friction-pendulum bearings, m (None: the flat
     /// joint; frames only).
     pub bearing_radius: Option<f64>,
+    /// The sliding joint's friction law, built on `friction` (see [`LawChoice`]).
+    pub law: LawChoice,
+}
+
+/// The friction law of the panel. `friction` (the ρ slider) is its sliding coefficient at
+/// rest: Coulomb's ρ, the kinetic μ_k, the velocity law's μ_slow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LawChoice {
+    /// One coefficient for sticking and sliding.
+    Coulomb,
+    /// Sticks up to μ_s = `stick`, slides at μ_k = ρ.
+    StaticKinetic {
+        /// Static coefficient μ_s.
+        stick: f64,
+    },
+    /// μ(v) = μ_fast − (μ_fast − ρ)·exp(−rate·|v|).
+    Velocity {
+        /// μ_fast.
+        fast: f64,
+        /// Rate, s/m.
+        rate: f64,
+    },
+}
+
+impl LawChoice {
+    /// The law with sliding coefficient at rest `friction` (None: Coulomb's, which the
+    /// friction coefficient alone says). A μ_s below μ_k, or a μ_fast below μ_slow, is
+    /// raised to it (the sliders move independently).
+    pub fn law(&self, friction: f64) -> Option<Friction> {
+        match *self {
+            LawChoice::Coulomb => None,
+            LawChoice::StaticKinetic { stick } => Some(Friction::StaticKinetic {
+                stick: stick.max(friction),
+                slide: friction,
+            }),
+            LawChoice::Velocity { fast, rate } => Some(Friction::Velocity {
+                slow: friction,
+                fast: fast.max(friction),
+                rate,
+            }),
+        }
+    }
 }
 
 /// The vertical component the "vertical shaking" toggle adds (the only built-in one).
@@ -151,6 +202,7 @@ impl Default for Controls {
             damping: 0.0,
             vertical: false,
             bearing_radius: None,
+            law: LawChoice::Coulomb,
         }
     }
 }
@@ -199,6 +251,7 @@ impl Controls {
         SimConfig {
             scene: self.scene.name(),
             friction: Some(self.friction),
+            friction_law: self.law.law(self.friction),
             alpha: two_block.then_some(self.alpha),
             excitation: match &self.record {
                 RecordChoice::Builtin(n) => Excitation::Record(n.clone()),
