@@ -184,6 +184,19 @@ impl Transform {
 }
 
 /// Clips a convex polygon (clip space) to an axis-aligned box (Sutherland–Hodgman).
+/// Whether a polygon turns the same way at every vertex (collinear vertices allowed).
+fn is_convex(pts: &[[f32; 2]]) -> bool {
+    let n = pts.len();
+    let (mut left, mut right) = (false, false);
+    for k in 0..n {
+        let [a, b, c] = [pts[k], pts[(k + 1) % n], pts[(k + 2) % n]];
+        let cross = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]);
+        left |= cross > 0.0;
+        right |= cross < 0.0;
+    }
+    !(left && right)
+}
+
 fn clip_polygon(points: &[[f32; 2]], clip: [f32; 4]) -> Vec<[f32; 2]> {
     let mut poly = points.to_vec();
     // (axis, bound, keep values >= bound?)
@@ -271,10 +284,20 @@ impl Painter<'_> {
         );
     }
 
-    /// A filled polygon (fan from its centroid: exact for the convex and star-shaped
-    /// blocks of the built-in scenes).
+    /// A filled polygon: a fan from its vertex average when it is convex (every block of
+    /// most scenes), ear clipping otherwise (a dish in the ground, a slab with feet), for
+    /// which a fan would paint outside the polygon.
     fn polygon(&mut self, pts: &[[f32; 2]], color: [f32; 4]) {
         if pts.len() < 3 {
+            return;
+        }
+        if !is_convex(pts) {
+            let mut triangles: Vec<u32> = Vec::new();
+            earcut::Earcut::new().earcut(pts.iter().copied(), &[], &mut triangles);
+            for t in triangles.chunks_exact(3) {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| pts[i as usize]);
+                self.triangle(a, b, c, color);
+            }
             return;
         }
         let n = pts.len() as f32;
