@@ -546,22 +546,20 @@ fn the_friction_law_and_the_block_scenes_are_in_the_panel() {
     );
     assert!(h.query_all_by_label_contains("μ_fast").next().is_some());
     slidebase::sim::prepare(last).expect("the frame runs on the velocity law");
-    for scene in [slidebase::ui::SceneChoice::Block] {
-        let controls = slidebase::ui::Controls {
-            scene: scene.clone(),
-            law: slidebase::ui::LawChoice::StaticKinetic { stick: 0.08 },
-            friction: 0.05,
-            ..Default::default()
-        };
-        let config = controls.config();
-        assert_eq!(
-            config.friction_law,
-            Some(Friction::StaticKinetic {
-                stick: 0.08,
-                slide: 0.05
-            })
-        );
-        let run = slidebase::sim::prepare(&config).expect("the scene sets up");
-        assert_eq!(run.models.len(), 2, "{scene:?} and its fixed base");
-    }
+    let controls = slidebase::ui::Controls {
+        scene: slidebase::ui::SceneChoice::Block,
+        law: slidebase::ui::LawChoice::StaticKinetic { stick: 0.08 },
+        friction: 0.05,
+        ..Default::default()
+    };
+    let config = controls.config();
+    assert_eq!(
+        config.friction_law,
+        Some(Friction::StaticKinetic {
+            stick: 0.08,
+            slide: 0.05
+        })
+    );
+    let run = slidebase::sim::prepare(&config).expect("the scene sets up");
+    assert_eq!(run.models.len(), 2, "the block and its fixed base");
 }
