@@ -523,8 +523,8 @@ fn the_pendulum_preset_runs_the_frame_on_both_bearings() {
 }
 
 /// Issue 15: the friction-law combo builds the law on the ρ slider (its coefficient at
-/// rest) and the run gets it instead of Coulomb's ρ; the sliding block is a scene of the
-/// panel, and sets up with either law.
+/// rest) and the run gets it instead of Coulomb's ρ; the sliding block and the friction
+/// pendulum are scenes of the panel, and set up.
 #[test]
 fn the_friction_law_and_the_block_scenes_are_in_the_panel() {
     use slidebase::model::friction::Friction;
@@ -546,20 +546,25 @@ fn the_friction_law_and_the_block_scenes_are_in_the_panel() {
     );
     assert!(h.query_all_by_label_contains("μ_fast").next().is_some());
     slidebase::sim::prepare(last).expect("the frame runs on the velocity law");
-    let controls = slidebase::ui::Controls {
-        scene: slidebase::ui::SceneChoice::Block,
-        law: slidebase::ui::LawChoice::StaticKinetic { stick: 0.08 },
-        friction: 0.05,
-        ..Default::default()
-    };
-    let config = controls.config();
-    assert_eq!(
-        config.friction_law,
-        Some(Friction::StaticKinetic {
-            stick: 0.08,
-            slide: 0.05
-        })
-    );
-    let run = slidebase::sim::prepare(&config).expect("the scene sets up");
-    assert_eq!(run.models.len(), 2, "the block and its fixed base");
+    for scene in [
+        slidebase::ui::SceneChoice::Block,
+        slidebase::ui::SceneChoice::FrictionPendulum,
+    ] {
+        let controls = slidebase::ui::Controls {
+            scene: scene.clone(),
+            law: slidebase::ui::LawChoice::StaticKinetic { stick: 0.08 },
+            friction: 0.05,
+            ..Default::default()
+        };
+        let config = controls.config();
+        assert_eq!(
+            config.friction_law,
+            Some(Friction::StaticKinetic {
+                stick: 0.08,
+                slide: 0.05
+            })
+        );
+        let run = slidebase::sim::prepare(&config).expect("the scene sets up");
+        assert_eq!(run.models.len(), 2, "{scene:?} and its fixed base");
+    }
 }

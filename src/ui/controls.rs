@@ -54,6 +54,8 @@ impl AppState {
                     .on_hover_text("the paper's simplest model: a mass on a spring over a raft that can slide; its exact solution is drawn dashed in the plots");
                 ui.selectable_value(c, SceneChoice::Block, SceneChoice::Block.label())
                     .on_hover_text("Newmark's sliding block: one rigid block on the joint, the textbook starting point; its exact solution is in the plots");
+                ui.selectable_value(c, SceneChoice::FrictionPendulum, SceneChoice::FrictionPendulum.label())
+                    .on_hover_text("a thin slider in a concave dish of radius 2 m: gravity pulls it back to the middle (period 2π√(R/g) = 2.8 s)");
                 let frame = if let SceneChoice::Frame(n) = c { *n } else { 5 };
                 ui.selectable_value(c, SceneChoice::Frame(frame), "frame of N storeys (generated)")
                     .on_hover_text("the paper's frame with any number of storeys");

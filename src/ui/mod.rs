@@ -36,6 +36,8 @@ pub enum SceneChoice {
     TwoBlock,
     /// Newmark's sliding block: one rigid block on the joint (`block`).
     Block,
+    /// A thin slider in a concave dish (`friction-pendulum`).
+    FrictionPendulum,
 
     /// The paper's frame with N storeys (`frame:N`).
     Frame(u32),
@@ -52,6 +54,7 @@ impl SceneChoice {
             SceneChoice::ThreeStorey => "three-storey".into(),
             SceneChoice::TwoBlock => "two-block".into(),
             SceneChoice::Block => "block".into(),
+            SceneChoice::FrictionPendulum => "friction-pendulum".into(),
             SceneChoice::Frame(n) => format!("frame:{n}"),
             SceneChoice::Wall(n) => format!("wall:{n}"),
             SceneChoice::File(p) => p.clone(),
@@ -64,6 +67,7 @@ impl SceneChoice {
             SceneChoice::ThreeStorey => "three-storey frame (paper Fig. 3)".into(),
             SceneChoice::TwoBlock => "two-mass model (paper Fig. 2)".into(),
             SceneChoice::Block => "sliding block (Newmark)".into(),
+            SceneChoice::FrictionPendulum => "friction pendulum (slider in a dish)".into(),
             SceneChoice::Frame(n) => format!("frame of {n} storeys"),
             SceneChoice::Wall(n) => format!("dry-stacked wall, {n} courses"),
             SceneChoice::File(p) => file_name(p),
