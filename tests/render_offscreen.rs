@@ -45,6 +45,7 @@ fn frame(slip: f64) -> ModelFrame {
             rect_block(-50.0, 50.0, -1.0, 0.0, true),
             rect_block(-1.0, 1.0, 0.0, 1.0, false),
         ],
+        single_body: false,
         contacts: vec![
             ContactFrame {
                 point: [-1.0, 0.0],

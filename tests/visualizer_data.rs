@@ -322,10 +322,14 @@ fn frame_by_frame_a_bonded_slider_moves_with_the_ground() {
     let mut k = 0;
     while (k as f64) * config.frame_dt < 14.0 {
         k += 1;
-        run.advance_to(k as f64 * config.frame_dt, &mut samples).unwrap();
+        run.advance_to(k as f64 * config.frame_dt, &mut samples)
+            .unwrap();
     }
     let fixed = samples.last().unwrap();
-    let peak_ground = fixed.ground_accel.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    let peak_ground = fixed
+        .ground_accel
+        .iter()
+        .fold(0.0_f64, |m, a| m.max(a.abs()));
     let peak = fixed.roof_accel.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
     let shortest = fixed
         .time
@@ -337,4 +341,30 @@ fn frame_by_frame_a_bonded_slider_moves_with_the_ground() {
         "bonded slider {peak} m/s² against the ground's {peak_ground}; shortest step {shortest} s"
     );
     assert!(shortest > 1e-4, "a sliver step of {shortest} s");
+}
+
+/// A lone sliding block is its own roof: the plots call its curve "block", draw no drift,
+/// and the headline compares the block's peak acceleration.
+#[test]
+fn a_lone_block_is_called_a_block_and_has_no_drift_plot() {
+    let config = SimConfig {
+        scene: "block".into(),
+        duration: Some(3.0),
+        ..Default::default()
+    };
+    let mut state = state_until(&config, 3.0, &PictureOptions::default()).unwrap();
+    state.play_time = 3.0;
+    assert!(state.timeline.single_body());
+    let data = PlotData::of(&state.timeline, 3.0, false);
+    assert!(data.drift.is_empty(), "no drift for a lone block");
+    assert!(
+        data.accel.iter().any(|c| c.name.starts_with("block, ")),
+        "{:?}",
+        data.accel.iter().map(|c| &c.name).collect::<Vec<_>>()
+    );
+    let headline = state.headline().expect("block against the fixed block").0;
+    assert!(headline.starts_with("peak block acceleration"), "{headline}");
+    // A frame keeps its roof.
+    let frame = state_until(&SimConfig::default(), 0.5, &PictureOptions::default()).unwrap();
+    assert!(!frame.timeline.single_body());
 }

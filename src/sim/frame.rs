@@ -87,6 +87,9 @@ pub struct ModelFrame {
     pub blocks: Vec<BlockFrame>,
     /// Index of the base block (the sliding slab or raft) in `blocks`.
     pub base: usize,
+    /// The base is the whole structure (a lone sliding block or slider): it has no roof
+    /// apart from itself and no drift.
+    pub single_body: bool,
     /// The base's outline at t = 0 relative to the ground: drawn on the ground, moved
     /// with it, it shows where the base started (its "ghost").
     pub base_start: Vec<[f32; 2]>,
@@ -406,6 +409,7 @@ impl Extractor {
             time: t,
             blocks,
             base: self.base,
+            single_body: self.base == self.roof,
             base_start,
             contacts,
             bolts: dda

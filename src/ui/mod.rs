@@ -307,6 +307,20 @@ pub struct Timeline {
 }
 
 impl Timeline {
+    /// What the plots and readouts call the top of the structure: "roof", or "block" when
+    /// the structure is a lone block (its own base and roof).
+    pub fn top_name(&self) -> &'static str {
+        if self.single_body() { "block" } else { "roof" }
+    }
+
+    /// Whether the run's structure is a lone block (see [`ModelFrame::single_body`]).
+    pub fn single_body(&self) -> bool {
+        self.frames
+            .first()
+            .and_then(|f| f.models.first())
+            .is_some_and(|m| m.single_body)
+    }
+
     /// Time of the last frame, s.
     pub fn available(&self) -> f64 {
         self.frames.last().map_or(0.0, |f| f.time)
@@ -852,7 +866,8 @@ impl AppState {
         let g = crate::ground_motion::STANDARD_GRAVITY;
         Some((
             format!(
-                "peak roof acceleration {:.2} g against {:.2} g with the {}: {:+.0} %",
+                "peak {} acceleration {:.2} g against {:.2} g with the {}: {:+.0} %",
+                self.timeline.top_name(),
                 main / g,
                 cmp / g,
                 labels[other],

@@ -149,11 +149,13 @@ impl PlotData {
                 Some(VERTICAL_COLOR),
             ));
         }
+        let top = timeline.top_name();
+        let single_body = timeline.single_body();
         for (k, s) in timeline.samples.iter().enumerate() {
             let n = upto(s);
             let label = labels.get(k).cloned().unwrap_or_default();
             d.accel.push(curve(
-                format!("roof, {label}"),
+                format!("{top}, {label}"),
                 thin(&s.time[..n], &s.roof_accel[..n], 1.0 / G),
                 Some(model_color(k)),
             ));
@@ -164,11 +166,14 @@ impl PlotData {
                     Some(model_color(k)),
                 ));
             }
-            d.drift.push(curve(
-                format!("drift, {label}"),
-                thin(&s.time[..n], &s.drift[..n], 1.0),
-                Some(model_color(k)),
-            ));
+            // A lone block is its own roof: it has no drift to plot.
+            if !single_body {
+                d.drift.push(curve(
+                    format!("drift, {label}"),
+                    thin(&s.time[..n], &s.drift[..n], 1.0),
+                    Some(model_color(k)),
+                ));
+            }
         }
         if let Some(e) = &timeline.exact {
             let computed = timeline.available();
@@ -390,19 +395,22 @@ pub fn plots_ui(state: &mut AppState, ui: &mut egui::Ui) {
         .show(ui, |ui| {
             plot(ui, "slip", &data.slip, ("s", "m"), cursor, &peak_m, height)
         });
-    egui::CollapsingHeader::new("roof drift (relative to the base)")
-        .default_open(true)
-        .show(ui, |ui| {
-            plot(
-                ui,
-                "drift",
-                &data.drift,
-                ("s", "m"),
-                cursor,
-                &peak_m,
-                height,
-            )
-        });
+    // A lone block has no drift: no empty plot for it.
+    if !data.drift.is_empty() {
+        egui::CollapsingHeader::new("roof drift (relative to the base)")
+            .default_open(true)
+            .show(ui, |ui| {
+                plot(
+                    ui,
+                    "drift",
+                    &data.drift,
+                    ("s", "m"),
+                    cursor,
+                    &peak_m,
+                    height,
+                )
+            });
+    }
     egui::CollapsingHeader::new("Fourier spectra of the accelerations")
         .default_open(false)
         .show(ui, |ui| {

@@ -219,13 +219,21 @@ fn model_labels(
         let color = super::plots::model_color(k);
         let title = galley(ui, label, big, color, w - 16.0);
         let p = model.probes;
-        let readout = format!(
-            "roof {:+.3} g   base {:+.3} g   slip {:+.3} m   drift {:+.1} mm",
-            p.roof_accel / STANDARD_GRAVITY,
-            p.base_accel / STANDARD_GRAVITY,
-            p.slip,
-            p.drift * 1e3
-        );
+        let readout = if model.single_body {
+            format!(
+                "block {:+.3} g   slip {:+.3} m",
+                p.base_accel / STANDARD_GRAVITY,
+                p.slip
+            )
+        } else {
+            format!(
+                "roof {:+.3} g   base {:+.3} g   slip {:+.3} m   drift {:+.1} mm",
+                p.roof_accel / STANDARD_GRAVITY,
+                p.base_accel / STANDARD_GRAVITY,
+                p.slip,
+                p.drift * 1e3
+            )
+        };
         let g_readout = galley(ui, readout, small, INK, w - 16.0);
         let pos = egui::pos2(x + 8.0, y + 4.0);
         let back = egui::Rect::from_min_size(
