@@ -363,7 +363,10 @@ fn a_lone_block_is_called_a_block_and_has_no_drift_plot() {
         data.accel.iter().map(|c| &c.name).collect::<Vec<_>>()
     );
     let headline = state.headline().expect("block against the fixed block").0;
-    assert!(headline.starts_with("peak block acceleration"), "{headline}");
+    assert!(
+        headline.starts_with("peak block acceleration"),
+        "{headline}"
+    );
     // A frame keeps its roof.
     let frame = state_until(&SimConfig::default(), 0.5, &PictureOptions::default()).unwrap();
     assert!(!frame.timeline.single_body());
