@@ -43,7 +43,7 @@ fn model(scene: &str) -> Option<Dda> {
     let motion = GroundMotion::Record(Arc::new(record));
     let params = SolverParams {
         duration: 1e9,
-        ..SolverParams::default()
+        ..SolverParams::for_scene(&scene)
     };
     Dda::new(&scene, Some(motion), params).ok()
 }

@@ -461,6 +461,11 @@ fn run_spec(args: &RunArgs) -> Result<RunSpec> {
 
 fn cmd_run(args: RunArgs) -> Result<()> {
     let mut setup = run_spec(&args)?.prepare()?;
+    // A run that takes a while says how far it has come (on stderr: the results and the
+    // JSON stay alone on stdout).
+    setup.progress = Some(slidebase::setup::ProgressReporter::new(5.0, 5.0, |p| {
+        eprintln!("run: {p}");
+    }));
     if let Some(dir) = &args.out {
         // A bad folder is reported now, not after the run.
         slidebase::post::output::prepare_dir(dir)?;
@@ -790,7 +795,16 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     out(&format!(
         "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
         s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
-    ))
+    ))?;
+    if s.dt_cuts > 0 {
+        let why = s.dt_cut_reasons;
+        out(&format!(
+            "  Δt cuts: {} because the open-close iteration did not settle, {} because a \
+             vertex moved too far in one step",
+            why.not_settled, why.too_far
+        ))?;
+    }
+    Ok(())
 }
 
 fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<()> {

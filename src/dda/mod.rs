@@ -23,4 +23,4 @@ pub use crate::model::friction::FrictionLaw;
 pub use energy::EnergyTerms;
 pub use params::{ContactEnforcement, Integrator, SolverParams};
 pub use rayleigh::RayleighDamping;
-pub use solver::{Dda, Modes, RunCounters, StepReport};
+pub use solver::{CutReasons, Dda, Modes, RunCounters, StepReport};

@@ -157,26 +157,7 @@ impl Integrator {
     }
 }
 
-/// How closed contacts carry their forces.
-///
-/// The default is the augmented Lagrangian: a stuck joint is exactly stuck, so the
-/// re-stick of the raft does not ring (with penalty springs a_base/a_g is +31 % at
-/// Δt = 1e-4 with the trapezoidal rule; test
-/// `augmented_lagrangian_contacts_do_not_ring_at_fine_steps`). The penalty method is kept
-/// for comparison with Shi's DDA and with codes that use it (OpenSees' flat slider).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum ContactEnforcement {
-    /// Shi's penalty springs: a closed contact is a stiff spring, so a stuck joint is an
-    /// oscillator (kHz) whose ringing at every re-stick equals the jump of the acceleration.
-    Penalty,
-    /// Augmented Lagrangian: the penalty springs only regularise the solve; multipliers
-    /// carry the contact forces, iterated until the constraint (no penetration, no slip
-    /// while stuck) holds to [`SolverParams::constraint_tolerance`]. A stuck joint is then
-    /// exactly stuck.
-    #[default]
-    AugmentedLagrangian,
-}
+pub use crate::model::enforcement::ContactEnforcement;
 
 /// Everything that controls the DDA solver (not the physics of the scene).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -223,6 +204,19 @@ pub struct SolverParams {
     /// Augmented Lagrangian: iterate until every closed contact's constraint violation,
     /// times its penalty, is below this fraction of the largest contact force.
     pub constraint_tolerance: f64,
+}
+
+impl SolverParams {
+    /// The defaults, with the contact enforcement the scene asks for (if it does).
+    pub fn for_scene(scene: &crate::model::Scene) -> Self {
+        let defaults = Self::default();
+        Self {
+            contact_enforcement: scene
+                .contact_enforcement
+                .unwrap_or(defaults.contact_enforcement),
+            ..defaults
+        }
+    }
 }
 
 impl Default for SolverParams {

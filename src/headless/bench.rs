@@ -216,7 +216,7 @@ pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
         Some(motion),
         SolverParams {
             duration: window,
-            ..SolverParams::default()
+            ..SolverParams::for_scene(&scene)
         },
     )?;
     let setup_s = setup.elapsed().as_secs_f64();

@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use super::simulate::{self, ModelRun, SPECTRUM_DT, SPECTRUM_MAX_SAMPLES};
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
-use crate::dda::{Dda, FrictionLaw, Integrator, SolverParams};
+use crate::dda::{CutReasons, Dda, FrictionLaw, Integrator, SolverParams};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::Scene;
 use crate::model::scene::ExcitationDef;
@@ -69,6 +69,8 @@ pub struct FrameSummary {
     pub open_close_passes: u64,
     /// Δt cuts (DDA).
     pub dt_cuts: u64,
+    /// What forced the Δt cuts.
+    pub dt_cut_reasons: CutReasons,
     /// Numeric factorisations of the system matrix (DDA; the other passes were solved
     /// with a kept factor).
     pub factorizations: u64,
@@ -186,6 +188,7 @@ fn summarise(
         steps: run.steps,
         open_close_passes: run.passes,
         dt_cuts: run.cuts,
+        dt_cut_reasons: run.cut_reasons,
         factorizations: run.factorizations,
         max_penetration_ratio: run.max_penetration_ratio,
         energy_residual_rel: run.energy_residual_rel,

@@ -5,13 +5,13 @@ use std::time::Instant;
 
 use crate::Result;
 use crate::analytic::ExactResult;
-use crate::dda::SolverParams;
+use crate::dda::{CutReasons, SolverParams};
 use crate::ground_motion::GroundMotion;
 use crate::limits::MAX_HISTORY_ROWS;
 use crate::model::Scene;
 use crate::post::history::{History, PeakTracker};
 use crate::post::spectrum::UniformSeries;
-use crate::setup::{ModelKind, RunSetup};
+use crate::setup::{ModelKind, RunProgress, RunSetup};
 
 /// Peak responses of a run, SI units.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
@@ -43,6 +43,8 @@ pub struct ModelRun {
     pub passes: u64,
     /// Δt cuts (DDA only).
     pub cuts: u64,
+    /// What forced them.
+    pub cut_reasons: CutReasons,
     /// Numeric factorisations of the system matrix (DDA only).
     pub factorizations: u64,
     /// Steps that ended with a sliding contact (DDA only; the exact model reports its
@@ -97,7 +99,24 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
     let mut step = 0usize;
     let mut last_slip = 0.0;
     let mut sliding_steps = 0;
+    let mut next_report = setup.progress.as_ref().map(|p| p.first_after_s);
     dda.run_until(duration, |d, report| {
+        // The clock is read every 256 steps: a small model takes ~10 µs for that many.
+        if let (Some(reporter), Some(due)) = (&setup.progress, next_report.as_mut())
+            && step.is_multiple_of(256)
+        {
+            let elapsed_s = start.elapsed().as_secs_f64();
+            if elapsed_s >= *due {
+                *due = elapsed_s + reporter.every_s;
+                reporter.report(&RunProgress {
+                    time_s: report.time,
+                    duration_s: duration,
+                    steps: step as u64,
+                    cuts: d.counters().cuts,
+                    elapsed_s,
+                });
+            }
+        }
         if report.sliding > 0 {
             sliding_steps += 1;
         }
@@ -142,6 +161,7 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         steps: counters.steps,
         passes: counters.passes,
         cuts: counters.cuts,
+        cut_reasons: counters.cut_reasons,
         factorizations: counters.factorizations,
         sliding_steps,
         max_penetration_ratio: counters.max_penetration_ratio,
@@ -249,6 +269,7 @@ impl ModelRun {
             steps,
             passes: 0,
             cuts: 0,
+            cut_reasons: CutReasons::default(),
             factorizations: 0,
             sliding_steps: 0,
             max_penetration_ratio: 0.0,

@@ -1,6 +1,7 @@
 //! Scenes as data: geometry, materials, the scene description and the built-in presets.
 
 pub mod bearing;
+pub mod enforcement;
 pub mod friction;
 pub mod generated;
 pub mod geometry;

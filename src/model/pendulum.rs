@@ -125,6 +125,7 @@ pub fn friction_pendulum(radius: f64) -> Result<Scene> {
             scale: 1.0,
         },
         vertical_excitation: None,
+        contact_enforcement: None,
         two_block: None,
         structure: None,
         sliding_block: Some(SlidingBlockRoles {

@@ -9,6 +9,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::enforcement::ContactEnforcement;
 use super::friction::Friction;
 use super::geometry::Point;
 use super::material::Material;
@@ -63,6 +64,14 @@ pub struct Scene {
     /// Roles of a sliding-block scene: the block and its joint (Newmark's sliding block).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sliding_block: Option<SlidingBlockRoles>,
+    /// How the closed contacts carry their forces, when the scene needs a particular way
+    /// (`"penalty"` or `"augmented-lagrangian"`; default: the solver's, the augmented
+    /// Lagrangian). Walls of dry-stacked blocks ask for penalty springs: a block resting
+    /// on two below touches them at several vertices per face, more constraints than it
+    /// has freedoms, so the individual multipliers are not determined and their iteration
+    /// stalls once the wall rocks (see [`crate::model::generated::wall`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_enforcement: Option<ContactEnforcement>,
 }
 
 /// Names the parts of a building so that runs can report slip, drift and floor responses.

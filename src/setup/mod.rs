@@ -12,11 +12,13 @@ mod check;
 pub mod defaults;
 pub mod modes;
 mod prepare;
+mod progress;
 pub mod response;
 mod spec;
 
 pub use check::{check_steps, exact_steps_for};
 pub use prepare::{RunSetup, SceneRoles};
+pub use progress::{ProgressReporter, RunProgress};
 pub use response::{Probe, Response};
 pub use spec::{
     ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneSource, VerticalSpec,

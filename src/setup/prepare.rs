@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use super::progress::ProgressReporter;
 use super::response::Probe;
 use super::spec::{ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec};
 use super::{check, defaults};
@@ -83,6 +84,8 @@ pub struct RunSetup {
     pub warnings: Vec<String>,
     /// The user confirmed a run beyond the step limit (`--confirm-large`).
     pub confirm_large: bool,
+    /// Told how the DDA run advances, on long runs (default: nobody).
+    pub progress: Option<ProgressReporter>,
 }
 
 impl RunSpec {
@@ -274,6 +277,7 @@ impl RunSpec {
             motion_scale: 1.0,
             warnings: Vec::new(),
             confirm_large: self.confirm_large,
+            progress: None,
         }
     }
 
@@ -449,7 +453,7 @@ impl RunSetup {
             dt: self.dt,
             duration: self.duration,
             integrator: self.integrator,
-            ..SolverParams::default()
+            ..SolverParams::for_scene(&self.scene)
         }
     }
 

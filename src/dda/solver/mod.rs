@@ -84,6 +84,18 @@ pub struct Modes {
     pub shapes: Vec<Vec<Vec6>>,
 }
 
+/// Δt cuts by what forced them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct CutReasons {
+    /// The open-close iteration did not settle in
+    /// [`SolverParams::max_open_close_passes`] passes (or judged a contact open while it
+    /// penetrates, or closed while apart).
+    pub not_settled: u64,
+    /// A vertex moved more than [`SolverParams::max_displacement_ratio`] of the structure
+    /// in one step.
+    pub too_far: u64,
+}
+
 /// Totals over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct RunCounters {
@@ -91,8 +103,10 @@ pub struct RunCounters {
     pub steps: u64,
     /// Open-close passes in accepted attempts.
     pub passes: u64,
-    /// Δt cuts.
+    /// Δt cuts (by what forced them in [`RunCounters::cut_reasons`]).
     pub cuts: u64,
+    /// What forced the Δt cuts.
+    pub cut_reasons: CutReasons,
     /// Largest penetration / structure size seen.
     pub max_penetration_ratio: f64,
     /// Largest |energy residual| relative to the energy scale seen so far.

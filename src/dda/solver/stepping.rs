@@ -276,10 +276,13 @@ impl Dda {
                 }
             }
             let reason = match outcome {
-                None => format!(
-                    "the open-close iteration did not settle in {} passes",
-                    self.params.max_open_close_passes
-                ),
+                None => {
+                    self.counters.cut_reasons.not_settled += 1;
+                    format!(
+                        "the open-close iteration did not settle in {} passes",
+                        self.params.max_open_close_passes
+                    )
+                }
                 Some((increments, passes)) => {
                     let ratio = self.max_relative_displacement(&increments, &known);
                     if ratio <= self.params.max_displacement_ratio {
@@ -325,6 +328,7 @@ impl Dda {
                         self.dt_current = (self.dt_current * 1.5).min(self.params.dt);
                         return Ok(Some(report));
                     }
+                    self.counters.cut_reasons.too_far += 1;
                     format!(
                         "a vertex moved {ratio:.2e} structure sizes in one step (limit {:.2e})",
                         self.params.max_displacement_ratio
