@@ -154,13 +154,18 @@ fn three_storey_on_pendulum_bearings_matches_its_mdof_counterpart() {
     );
 }
 
-/// `--bearing pendulum` goes under frames only; a lone block is refused with the flag.
+/// `--bearing` goes under frames only, flat or pendulum (a flag that does not apply is
+/// refused, not ignored); a lone block is refused with the flag.
 #[test]
-fn a_pendulum_bearing_is_refused_off_a_frame() {
+fn a_bearing_is_refused_off_a_frame() {
     use slidebase::model::bearing::Bearing;
-    for scene in ["block", "two-block", "friction-pendulum"] {
+    let bearings = [Bearing::Flat, Bearing::Pendulum { radius: 2.0 }];
+    for (scene, bearing) in ["block", "two-block", "friction-pendulum"]
+        .into_iter()
+        .flat_map(|scene| bearings.map(|b| (scene, b)))
+    {
         let e = RunSpec {
-            bearing: Some(Bearing::Pendulum { radius: 2.0 }),
+            bearing: Some(bearing),
             ..RunSpec::scene(scene)
         }
         .prepare()
@@ -168,7 +173,7 @@ fn a_pendulum_bearing_is_refused_off_a_frame() {
         .to_string();
         assert!(
             e.contains("--bearing") && e.contains("frame"),
-            "{scene}: {e}"
+            "{scene}, {bearing:?}: {e}"
         );
     }
 }

@@ -149,13 +149,14 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
         crate::error::require_range("--damping", zeta, 0.0, 0.99, "(the damping ratio ζ)")?;
         check_damping_applies(scene)?;
     }
-    if spec.bearing.and_then(|b| b.radius()).is_some() && scene.structure.is_none() {
+    // `--bearing flat` too: it names the bearing under a frame's base slab, and a scene
+    // without one would silently ignore it.
+    if spec.bearing.is_some() && scene.structure.is_none() {
         return Err(Error::invalid(
             "--bearing",
             format!(
-                "pendulum bearings go under a frame's base slab (three-storey, frame:N); \
-                 '{}' is not a frame (for a lone slider on a dish, run --scene \
-                 friction-pendulum)",
+                "bearings go under a frame's base slab (three-storey, frame:N); '{}' is \
+                 not a frame (for a lone slider on a dish, run --scene friction-pendulum)",
                 scene.name
             ),
         ));
