@@ -53,7 +53,7 @@ fn steps(c: &mut Criterion) {
     group
         .sample_size(10)
         .measurement_time(Duration::from_secs(8));
-    for scene in ["three-storey", "frame:30", "wall:10"] {
+    for scene in ["three-storey", "frame:20", "wall:10"] {
         let Some(start) = model(scene) else {
             eprintln!("cannot build {scene}");
             continue;

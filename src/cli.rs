@@ -1119,10 +1119,18 @@ fn cmd_list() -> Result<()> {
         out(&format!("  {s}"))?;
     }
     out("generated scenes:")?;
+    let frame = format!(
+        "frame:N (the paper's frame with N storeys, 1 to {})",
+        slidebase::model::generated::MAX_FRAME_STOREYS
+    );
+    let wall = format!(
+        "wall:N (N courses of dry-stacked blocks, 1 to {})",
+        slidebase::model::generated::MAX_WALL
+    );
     for s in [
         "friction-pendulum (--radius R, or friction-pendulum:R)",
-        "frame:N",
-        "wall:N",
+        &frame,
+        &wall,
     ] {
         out(&format!("  {s}"))?;
     }

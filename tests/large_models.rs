@@ -130,3 +130,25 @@ fn a_long_run_reports_its_progress() {
     let last = seen.last().unwrap();
     assert!(last.time_s <= 2.0 && last.duration_s == 2.0 && last.fraction() > 0.8);
 }
+
+/// The paper's frame stands up to `MAX_FRAME_STOREYS` storeys (its first sway mode has a
+/// positive frequency, though P-Δ has taken most of it: 0.638 Hz at 3 storeys), and one
+/// storey more is refused with the reason, not left to fail in the settle.
+#[test]
+fn the_tallest_frame_stands_and_a_taller_one_is_refused() {
+    use slidebase::model::generated::MAX_FRAME_STOREYS;
+    let tallest = resolve_scene(&format!("frame:{MAX_FRAME_STOREYS}")).unwrap();
+    let first = slidebase::headless::frame::modes(&tallest)
+        .unwrap()
+        .frequencies_hz[0];
+    assert!(
+        first > 0.01 && first < 0.638,
+        "first sway frequency {first} Hz"
+    );
+    let taller = format!("frame:{}", MAX_FRAME_STOREYS + 1);
+    let e = resolve_scene(&taller).unwrap_err().to_string();
+    assert!(
+        e.contains("--scene") && e.contains("buckles") && e.contains("frame:21"),
+        "{e}"
+    );
+}

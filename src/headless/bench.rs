@@ -292,22 +292,15 @@ pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Benc
             (
                 0.1,
                 &[
-                    "frame:3", "frame:10", "frame:30", "wall:5", "wall:10", "wall:20",
+                    "frame:3", "frame:10", "frame:20", "wall:5", "wall:10", "wall:20",
                 ],
             )
         } else {
             (
                 0.5,
                 &[
-                    "frame:3",
-                    "frame:10",
-                    "frame:30",
-                    "frame:100",
-                    "wall:5",
-                    "wall:10",
-                    "wall:15",
-                    "wall:22",
-                    "wall:31",
+                    "frame:3", "frame:10", "frame:15", "frame:21", "wall:5", "wall:10", "wall:15",
+                    "wall:22", "wall:31",
                 ],
             )
         };

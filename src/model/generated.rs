@@ -18,9 +18,18 @@ use super::scene::{
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::{Error, Result};
 
-/// Largest generated size accepted (a 100-storey frame has 301 blocks; a 40 × 40 wall
-/// 1602): beyond it a run needs more memory and time than a study should silently take.
+/// Largest generated size accepted (a 100-storey frame would have 301 blocks; a 40 × 40
+/// wall 1602): beyond it a run needs more memory and time than a study should silently
+/// take.
 pub const MAX_SIZE: usize = 100;
+
+/// Tallest frame that stands: the paper's floors are heavy (they give the three-storey
+/// frame its 0.638 Hz) and its columns slender, so the weight above a storey over the
+/// storey height (P-Δ) eats the columns' lateral stiffness as floors are added. The first
+/// sway frequency falls from 0.638 Hz (3 storeys) to 0.058 Hz (20) and 0.050 Hz (21), and
+/// is gone at 22: that frame buckles under its own weight (its settle under gravity fails,
+/// as it should). `slidebase modes --scene frame:N` shows it.
+pub const MAX_FRAME_STOREYS: usize = 21;
 
 /// A generated scene from its spelling `frame:N`, `wall:N` or `friction-pendulum[:R]`
 /// (see [`super::pendulum`]), or `None` when the name is
@@ -120,6 +129,17 @@ fn ground_block(half_length: f64) -> BlockDef {
 /// and joint as in `assets/scenes/three-storey.toml` (which `frame:3` reproduces).
 pub fn frame(storeys: usize) -> Result<Scene> {
     check_size("frame", storeys, MAX_SIZE)?;
+    if storeys > MAX_FRAME_STOREYS {
+        return Err(Error::invalid(
+            "--scene",
+            format!(
+                "frame:{storeys}: the paper's frame buckles under its own weight above \
+                 {MAX_FRAME_STOREYS} storeys (its heavy floors' weight over the storey height \
+                 exceeds the slender columns' lateral stiffness: P-Δ); take frame:1 to \
+                 frame:{MAX_FRAME_STOREYS}"
+            ),
+        ));
+    }
     // Slab density that gives the three-storey frame its 0.638 Hz (see that scene);
     // columns carry 1 % of it.
     let slab = concrete(1_789_400.0);
