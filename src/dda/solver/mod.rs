@@ -174,6 +174,9 @@ pub struct Dda {
     elements: Vec<ElementTerms>,
     pairs: Vec<ContactPair>,
     contacts: Vec<Contact>,
+    /// A second contact list, for the contacts of the geometry after a step while the
+    /// step's own are still read (swapped, not copied).
+    spare_contacts: Vec<Contact>,
     memory: ContactMemories,
     bolts: Vec<Bolt>,
     fixed: Vec<FixedPoint>,
@@ -429,6 +432,7 @@ impl Dda {
             elements: Vec::new(),
             pairs,
             contacts: Vec::new(),
+            spare_contacts: Vec::new(),
             memory: ContactMemories::default(),
             bolts,
             fixed,

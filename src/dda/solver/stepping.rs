@@ -608,12 +608,12 @@ impl Dda {
         }
         if increments.is_none() {
             // The contacts' forces act along directions that turn with the blocks: at the
-            // current geometry the contacts are found again (the step's own, which the
-            // caller still reads, are kept).
-            let step_contacts = self.contacts.clone();
+            // current geometry the contacts are found again, into the spare list (the
+            // step's own, which the caller still reads, are set aside meanwhile).
+            std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
             self.detect_contacts();
             self.add_contact_forces(&mut out);
-            self.contacts = step_contacts;
+            std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
         }
         out
     }
