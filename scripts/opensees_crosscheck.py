@@ -12,6 +12,8 @@ import time
 import numpy as np
 import openseespy.opensees as ops
 
+from opensees_common import settle_under_gravity, start_transient, step
+
 G = 9.80665
 import os
 REC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "assets", "records", "el_centro_1940_ns.csv")
@@ -79,44 +81,25 @@ def main():
         ops.element("singleFPBearing", 1, 1, 2, 1, args.R, kinit, "-P", 1, "-Mz", 2, *orient, *itr)
 
     # gravity: static, then held constant
-    ops.timeSeries("Linear", 1)
-    ops.pattern("Plain", 1, 1)
-    ops.load(2, 0.0, -W, 0.0)
-    ops.constraints("Plain")
-    ops.numberer("Plain")
-    ops.system("FullGeneral")
-    ops.test("NormDispIncr", 1e-12, 50)
-    ops.algorithm("Newton")
-    ops.integrator("LoadControl", 0.1)
-    ops.analysis("Static")
-    assert ops.analyze(10) == 0
-    ops.loadConst("-time", 0.0)
+    settle_under_gravity(2, W)
     uy_static = ops.nodeDisp(2, 2)
 
     # uniform excitation in x, accel in m/s^2, linear interpolation of the 0.02 s record
     ops.timeSeries("Path", 2, "-dt", dt_rec, "-values", *a_rec_g.tolist(), "-factor", G)
     ops.pattern("UniformExcitation", 2, 1, "-accel", 2)
 
-    ops.wipeAnalysis()
-    ops.constraints("Plain")
-    ops.numberer("Plain")
-    ops.system("FullGeneral")
-    ops.test("NormDispIncr", args.tol, 100)
-    ops.algorithm("Newton")
     if args.integrator == "newmark":
-        ops.integrator("Newmark", 0.5, 0.25)
+        integrator = ("Newmark", 0.5, 0.25)
     elif args.integrator.startswith("hht:"):
-        ops.integrator("HHT", float(args.integrator[4:]))
+        integrator = ("HHT", float(args.integrator[4:]))
     elif args.integrator.startswith("genalpha:"):
         r = float(args.integrator[9:])  # Chung-Hulbert parameters from rho_inf
         am, af = (2 * r - 1) / (r + 1), r / (r + 1)
         # OpenSees GeneralizedAlpha(alphaM, alphaF) uses alpha = 1 - (CH alpha)
-        ops.integrator("GeneralizedAlpha", 1 - am, 1 - af)
+        integrator = ("GeneralizedAlpha", 1 - am, 1 - af)
     else:
         raise SystemExit("unknown integrator")
-    if args.betaK > 0:
-        ops.rayleigh(0.0, args.betaK, 0.0, 0.0)
-    ops.analysis("Transient")
+    start_transient(args.tol, integrator, args.betaK)
 
     n = int(round(T / args.dt))
     ts = np.empty(n + 1); u = np.empty(n + 1); aa = np.empty(n + 1); vv = np.empty(n + 1)
@@ -125,19 +108,7 @@ def main():
     fails = 0
     t0 = time.time()
     for i in range(1, n + 1):
-        ok = ops.analyze(1, args.dt)
-        if ok != 0:
-            # retry with substeps
-            fails += 1
-            sub = 10
-            for _ in range(sub):
-                ok = ops.analyze(1, args.dt / sub)
-                if ok != 0:
-                    ops.algorithm("ModifiedNewton", "-initial")
-                    ok = ops.analyze(1, args.dt / sub)
-                    ops.algorithm("Newton")
-                if ok != 0:
-                    raise SystemExit(f"failed at t={ops.getTime()}")
+        fails += step(args.dt)
         tt = ops.getTime()
         ts[i] = tt
         u[i] = ops.nodeDisp(2, 1)            # relative to fixed node 1 = relative to ground

@@ -22,6 +22,8 @@ import time
 
 import openseespy.opensees as ops
 
+from opensees_common import settle_under_gravity, start_transient, step
+
 G = 9.80665
 
 
@@ -56,31 +58,13 @@ def run(args):
     ops.element("zeroLength", 2, 2, 3, "-mat", 3, "-dir", 1)
 
     # Gravity through the bearing, then held.
-    ops.timeSeries("Linear", 1)
-    ops.pattern("Plain", 1, 1)
-    ops.load(2, 0.0, -weight, 0.0)
-    ops.constraints("Plain")
-    ops.numberer("Plain")
-    ops.system("FullGeneral")
-    ops.test("NormDispIncr", 1e-12, 50)
-    ops.algorithm("Newton")
-    ops.integrator("LoadControl", 0.1)
-    ops.analysis("Static")
-    assert ops.analyze(10) == 0
-    ops.loadConst("-time", 0.0)
+    settle_under_gravity(2, weight)
 
     # a_g(t) = A sin(Omega t).
     ops.timeSeries("Trig", 2, 0.0, args.duration + 1.0, 2 * math.pi / big_omega,
                    "-factor", amplitude)
     ops.pattern("UniformExcitation", 2, 1, "-accel", 2)
-    ops.wipeAnalysis()
-    ops.constraints("Plain")
-    ops.numberer("Plain")
-    ops.system("FullGeneral")
-    ops.test("NormDispIncr", 1e-12, 100)
-    ops.algorithm("Newton")
-    ops.integrator("Newmark", 0.5, 0.25)
-    ops.analysis("Transient")
+    start_transient(1e-12, ("Newmark", 0.5, 0.25))
 
     steps = int(round(args.duration / args.dt))
     us_max = 0.0
@@ -88,17 +72,7 @@ def run(args):
     start = time.perf_counter()
     retries = 0
     for _ in range(steps):
-        if ops.analyze(1, args.dt) != 0:
-            # As in scripts/opensees_crosscheck.py: ten substeps, falling back to
-            # modified Newton on the initial tangent.
-            retries += 1
-            for _ in range(10):
-                if ops.analyze(1, args.dt / 10) != 0:
-                    ops.algorithm("ModifiedNewton", "-initial")
-                    ok = ops.analyze(1, args.dt / 10)
-                    ops.algorithm("Newton")
-                    if ok != 0:
-                        raise SystemExit(f"OpenSees failed at t = {ops.getTime()}")
+        retries += step(args.dt)
         t = ops.getTime()
         us_max = max(us_max, abs(ops.nodeDisp(2, 1)))
         a_abs = ops.nodeAccel(2, 1) + amplitude * math.sin(big_omega * t)

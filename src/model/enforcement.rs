@@ -20,8 +20,8 @@ pub enum ContactEnforcement {
     Penalty,
     /// Augmented Lagrangian: the penalty springs only regularise the solve; multipliers
     /// carry the contact forces, iterated until the constraint (no penetration, no slip
-    /// while stuck) holds to [`crate::dda::SolverParams::constraint_tolerance`]. A stuck joint is then
-    /// exactly stuck.
+    /// while stuck) holds to [`crate::dda::SolverParams::constraint_tolerance`]. A stuck
+    /// joint is then exactly stuck.
     #[default]
     AugmentedLagrangian,
 }

@@ -324,7 +324,8 @@ impl PreparedRun {
 
     /// Advances every model to time `t`, appending one row per solver step to `samples`.
     /// The models are independent, so each runs on its own thread (the default scene's
-    /// two frames advance twice as fast on two cores); the first error is returned.
+    /// two frames: 1.46× faster on two cores, docs/performance.md); the first model's
+    /// error in scene order is returned.
     pub fn advance_to(&mut self, t: f64, samples: &mut [Samples]) -> Result<()> {
         let motion = &self.motion;
         let advance = |((dda, ex), s): (&mut (Dda, Extractor), &mut Samples)| {
