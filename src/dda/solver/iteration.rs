@@ -10,8 +10,8 @@ impl Dda {
         mode: Mode,
         known: &[Vec6],
     ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
-        let mut elements = std::mem::take(&mut self.elements);
-        self.element_terms_into(&mut elements);
+        self.refresh_element_terms();
+        let elements = std::mem::take(&mut self.elements);
         let mut base = self
             .base_system
             .take()

@@ -170,8 +170,12 @@ pub struct Dda {
     pass_system: Option<System>,
     /// The step's system without contacts (kept to reuse its storage).
     base_system: Option<System>,
-    /// The step's joint terms (kept to reuse their storage).
+    /// The joints' terms (kept to reuse their storage).
     elements: Vec<ElementTerms>,
+    /// `elements` are the terms of the joints as they are now: the rebalance after a step
+    /// computes them at the new geometry, and the next step (or its cut retries) reuses
+    /// them instead of computing them again. Only `commit_geometry` moves the joints.
+    elements_current: bool,
     pairs: Vec<ContactPair>,
     contacts: Vec<Contact>,
     /// A second contact list, for the contacts of the geometry after a step while the
@@ -430,6 +434,7 @@ impl Dda {
             pass_system: None,
             base_system: None,
             elements: Vec::new(),
+            elements_current: false,
             pairs,
             contacts: Vec::new(),
             spare_contacts: Vec::new(),

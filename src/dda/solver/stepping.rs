@@ -44,6 +44,7 @@ impl Dda {
             increments,
             rotations: &rotations,
         };
+        self.elements_current = false;
         for b in &mut self.bolts {
             b.commit(&motion);
         }
@@ -576,13 +577,12 @@ impl Dda {
                 f[3 + i] -= b.moments.area * stress;
             }
         }
-        // The step's own terms (kept from its assembly) for its end forces; fresh ones
-        // at the current geometry.
-        let elements = if increments.is_some() {
-            std::mem::take(&mut self.elements)
-        } else {
-            self.element_terms()
-        };
+        // The step's own terms (kept from its assembly) for its end forces; those of the
+        // current geometry otherwise (kept for the next step's assembly).
+        if increments.is_none() {
+            self.refresh_element_terms();
+        }
+        let elements = std::mem::take(&mut self.elements);
         for e in &elements {
             let nodes = e.nodes();
             let u: SmallVec<[Point; 3]> = nodes
@@ -597,9 +597,7 @@ impl Dda {
                 }
             }
         }
-        if increments.is_some() {
-            self.elements = elements;
-        }
+        self.elements = elements;
         for l in &self.loads {
             let g = t_transpose_times(centroids[l.block], l.point, l.force);
             for i in 0..6 {

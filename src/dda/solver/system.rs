@@ -17,6 +17,17 @@ impl Dda {
         out.extend(self.connections.iter().map(Connection::terms));
     }
 
+    /// Makes `self.elements` the terms of the joints as they are now (computing them only
+    /// if the joints moved since they were last computed).
+    pub(super) fn refresh_element_terms(&mut self) {
+        if !self.elements_current {
+            let mut elements = std::mem::take(&mut self.elements);
+            self.element_terms_into(&mut elements);
+            self.elements = elements;
+            self.elements_current = true;
+        }
+    }
+
     /// Assembles everything that does not depend on contact states (into a new system).
     pub(super) fn assemble_base(
         &self,
