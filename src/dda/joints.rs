@@ -77,6 +77,11 @@ impl ElementTerms {
         out
     }
 
+    /// Node forces at the step start: fe (the first 2n entries).
+    pub fn start_forces(&self) -> [f64; 6] {
+        self.fe
+    }
+
     /// Node forces at the end of the step: fe + ke·u (the first 2n entries).
     pub fn end_forces(&self, u: &[Point]) -> [f64; 6] {
         let dim = 2 * self.count;

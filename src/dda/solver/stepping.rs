@@ -585,11 +585,17 @@ impl Dda {
         let elements = std::mem::take(&mut self.elements);
         for e in &elements {
             let nodes = e.nodes();
-            let u: SmallVec<[Point; 3]> = nodes
-                .iter()
-                .map(|&(b, x)| point_displacement(centroids[b], x, inc(b)))
-                .collect();
-            let forces = e.end_forces(&u);
+            let forces = match increments {
+                // The terms were computed at this geometry: their force is the start force.
+                None => e.start_forces(),
+                Some(d) => {
+                    let mut u = [[0.0; 2]; 3];
+                    for (uk, &(b, x)) in u.iter_mut().zip(nodes) {
+                        *uk = point_displacement(centroids[b], x, &d[b]);
+                    }
+                    e.end_forces(&u[..nodes.len()])
+                }
+            };
             for (k, &(b, x)) in nodes.iter().enumerate() {
                 let g = t_transpose_times(centroids[b], x, [forces[2 * k], forces[2 * k + 1]]);
                 for i in 0..6 {
