@@ -583,6 +583,8 @@ impl Dda {
             self.refresh_element_terms();
         }
         let elements = std::mem::take(&mut self.elements);
+        // Plain slices: indexing a SmallVec branches on where it is stored, every time.
+        let (centroids, totals) = (centroids.as_slice(), out.as_mut_slice());
         for e in &elements {
             let nodes = e.nodes();
             let forces = match increments {
@@ -598,8 +600,8 @@ impl Dda {
             };
             for (k, &(b, x)) in nodes.iter().enumerate() {
                 let g = t_transpose_times(centroids[b], x, [forces[2 * k], forces[2 * k + 1]]);
-                for i in 0..6 {
-                    out[b][i] -= g[i];
+                for (total, gi) in totals[b].iter_mut().zip(g) {
+                    *total -= gi;
                 }
             }
         }
