@@ -500,6 +500,8 @@ pub struct LinearSolver {
     fresh: bool,
     /// Scratch for [`LinearSolver::solve_change`].
     change: Vec<f64>,
+    /// ‖K‖∞ of the matrix of the last solve, once computed (a change solve reuses it).
+    matrix_norm: Option<f64>,
 }
 
 /// A kept factor and what it is for.
@@ -578,6 +580,7 @@ impl Clone for LinearSolver {
             stats: self.stats,
             fresh: false,
             change: Vec::new(),
+            matrix_norm: None,
         }
     }
 }
@@ -643,6 +646,7 @@ impl LinearSolver {
             stats: SolverStats::default(),
             fresh: false,
             change: Vec::new(),
+            matrix_norm: None,
             pattern,
         })
     }
@@ -656,6 +660,18 @@ impl LinearSolver {
     /// than drifting it or changing it by a low rank (the step size, the scheme): a kept
     /// factor is only tried for a matrix with the same key.
     pub fn solve(
+        &mut self,
+        k: &BlockMatrix,
+        rhs: &[f64],
+        structure: u64,
+        x: &mut [f64],
+    ) -> Result<(), SolveError> {
+        self.matrix_norm = None;
+        self.solve_same_matrix(k, rhs, structure, x)
+    }
+
+    /// [`LinearSolver::solve`] for the matrix of the last solve (its norm is kept).
+    fn solve_same_matrix(
         &mut self,
         k: &BlockMatrix,
         rhs: &[f64],
@@ -718,7 +734,7 @@ impl LinearSolver {
             self.apply_inverse(&mut change);
             Ok(())
         } else {
-            self.solve(k, delta, structure, &mut change)
+            self.solve_same_matrix(k, delta, structure, &mut change)
         };
         for (xi, ci) in x.iter_mut().zip(&change) {
             *xi += ci;
@@ -734,7 +750,10 @@ impl LinearSolver {
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>();
         let rhs_norm = norm(rhs);
         let [mut r, mut z, mut p, mut q] = std::mem::take(&mut self.work);
-        let k_norm = k.norm_inf(&mut q);
+        let k_norm = match self.matrix_norm {
+            Some(norm) => norm,
+            None => *self.matrix_norm.insert(k.norm_inf(&mut q)),
+        };
         // Start from the kept factor's solution.
         x.copy_from_slice(rhs);
         self.apply_inverse(x);
