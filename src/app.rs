@@ -142,6 +142,12 @@ fn save_color_image(path: &std::path::Path, image: &egui::ColorImage) -> Result<
 }
 
 impl eframe::App for App {
+    /// The panel colour: the panels and the scene are drawn without their own fill (see
+    /// `ui::unfilled_panel`).
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        visuals.panel_fill.to_normalized_gamma_f32()
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         if self.dark != Some(self.state.view.dark) {

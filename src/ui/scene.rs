@@ -125,8 +125,8 @@ fn galley(
 
 /// Draws the scene with its overlays into `rect`; returns the layout used (in points).
 pub fn draw_scene(ui: &mut egui::Ui, rect: egui::Rect, s: &SceneInputs) -> SceneLayout {
+    // No fill: the window is cleared with the panel colour (see `unfilled_panel`).
     let painter = ui.painter_at(rect);
-    painter.rect_filled(rect, 0.0, ui.visuals().panel_fill);
     let big = (rect.width() / 55.0).clamp(13.0, 22.0);
     let small = (big * 0.72).clamp(11.0, 15.0);
     // Header: time, ground, record; the headline below.
