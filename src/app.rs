@@ -19,6 +19,13 @@ pub const NO_DISPLAY_HELP: &str = "no display to open a window on; the same simu
 /// The shortest time between two frames while playing (a 60 Hz cap).
 const FRAME_INTERVAL: Duration = Duration::from_micros(16_667);
 
+/// While a run is being computed the window redraws at most this often (10 frames a
+/// second): its frames are drawn by the same cores that compute, and where they are drawn
+/// in software (Mesa's llvmpipe, a machine without a GPU) a frame costs ~50 ms of CPU.
+/// The default run then computes at ~21× real time in the window instead of ~17× at 30
+/// frames a second (docs/performance.md); the computation lasts a second or two.
+const COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(100);
+
 struct App {
     state: AppState,
     sim: SimHandle,
@@ -68,7 +75,9 @@ pub fn run_app() -> Result<()> {
                     render_state.target_format,
                 ));
             let ctx = cc.egui_ctx.clone();
-            let sim = SimHandle::spawn_with_waker(Box::new(move || ctx.request_repaint()));
+            let sim = SimHandle::spawn_with_waker(Box::new(move || {
+                ctx.request_repaint_after(COMPUTING_FRAME_INTERVAL)
+            }));
             let (shots_tx, shots_rx) = std::sync::mpsc::channel();
             Ok(Box::new(App {
                 state: AppState::default(),
@@ -173,8 +182,14 @@ impl eframe::App for App {
         self.shell_requests(&ctx);
         self.frames_drawn += 1;
         if self.state.playing && self.state.animating() {
-            // Paced: the next frame no sooner than 1/60 s after this one began.
-            ctx.request_repaint_after(FRAME_INTERVAL.saturating_sub(now.elapsed()));
+            // Paced: the next frame no sooner than 1/60 s after this one began (1/20 s
+            // while the run is still being computed).
+            let interval = if self.state.timeline.finished {
+                FRAME_INTERVAL
+            } else {
+                COMPUTING_FRAME_INTERVAL
+            };
+            ctx.request_repaint_after(interval.saturating_sub(now.elapsed()));
         }
         if let Some(after) = self.exit_after {
             let elapsed = self.started.elapsed().as_secs_f64();

@@ -323,30 +323,73 @@ impl PreparedRun {
     }
 
     /// Advances every model to time `t`, appending one row per solver step to `samples`.
-    /// The models are independent, so each runs on its own thread (the default scene's
-    /// two frames: 1.46× faster on two cores, docs/performance.md); the first model's
+    /// The models are independent, so each runs on its own thread; the first model's
     /// error in scene order is returned.
     pub fn advance_to(&mut self, t: f64, samples: &mut [Samples]) -> Result<()> {
-        let motion = &self.motion;
-        let advance = |((dda, ex), s): (&mut (Dda, Extractor), &mut Samples)| {
+        self.on_each_model(samples, |dda, ex, s, motion| {
             dda.run_until(t, |d, _| ex.sample(d, Some(motion), s))
-        };
+        })?;
+        Ok(())
+    }
+
+    /// Advances every model through the frame times `times` (increasing), appending one
+    /// row per solver step to `samples`, and returns a frame set at each time. Each model
+    /// runs through all of them on its own thread: the threads meet once per call, not
+    /// once per frame (the default scene's two frames on two cores: 1.43× faster than one
+    /// after the other with a meeting per frame, 1.8× with one per eight frames;
+    /// docs/performance.md).
+    pub fn advance_frames(
+        &mut self,
+        times: &[f64],
+        samples: &mut [Samples],
+    ) -> Result<Vec<FrameSet>> {
+        let per_model = self.on_each_model(samples, |dda, ex, s, motion| {
+            let mut frames = Vec::with_capacity(times.len());
+            for &t in times {
+                dda.run_until(t, |d, _| ex.sample(d, Some(motion), s))?;
+                frames.push((dda.time(), ex.extract(dda, Some(motion))));
+            }
+            Ok(frames)
+        })?;
+        let mut columns: Vec<_> = per_model.into_iter().map(Vec::into_iter).collect();
+        Ok(times
+            .iter()
+            .map(|&t| {
+                let row: Vec<_> = columns.iter_mut().filter_map(Iterator::next).collect();
+                FrameSet {
+                    time: row.first().map_or(t, |r| r.0),
+                    models: row.into_iter().map(|r| r.1).collect(),
+                }
+            })
+            .collect())
+    }
+
+    /// Runs `work` on every model, each on its own scoped thread (the first on this one),
+    /// and returns the results in scene order, or the first model's error in that order.
+    fn on_each_model<R: Send>(
+        &mut self,
+        samples: &mut [Samples],
+        work: impl Fn(&mut Dda, &mut Extractor, &mut Samples, &GroundMotion) -> Result<R> + Sync,
+    ) -> Result<Vec<R>> {
+        let motion = &self.motion;
+        let work = &work;
         let mut pairs = self.models.iter_mut().zip(samples.iter_mut());
-        let Some(first) = pairs.next() else {
-            return Ok(());
+        let Some(((dda, ex), s)) = pairs.next() else {
+            return Ok(Vec::new());
         };
         std::thread::scope(|scope| {
             let others: Vec<_> = pairs
-                .map(|pair| scope.spawn(move || advance(pair)))
+                .map(|((dda, ex), s)| scope.spawn(move || work(dda, ex, s, motion)))
                 .collect();
-            let mut result = advance(first);
+            let mut results = vec![work(dda, ex, s, motion)];
             for handle in others {
-                let other = handle
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                result = result.and(other);
+                results.push(
+                    handle
+                        .join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                );
             }
-            result
+            results.into_iter().collect()
         })
     }
 
@@ -625,7 +668,8 @@ fn run_one(
     let mut batch = Vec::new();
     let mut last_send = Instant::now();
     let (mut extract_total, mut extracted) = (0.0, 0u64);
-    let mut next_frame = config.frame_dt;
+    let mut next_frame = 1u64;
+    let mut chunk = FrameChunk::new();
     loop {
         // Commands first: a new run replaces this one at once.
         match commands.try_recv() {
@@ -633,19 +677,27 @@ fn run_one(
             Ok(SimCommand::Quit) | Err(TryRecvError::Disconnected) => return RunEnd::Quit,
             Err(TryRecvError::Empty) => {}
         }
-        let target = next_frame.min(run.duration);
-        if let Err(e) = run.advance_to(target, &mut samples) {
-            let _ = out.send(SimMessage::Failed {
-                generation,
-                message: e.to_string(),
-            });
-            return RunEnd::Failed;
+        let times = chunk.times(next_frame, config.frame_dt, run.duration);
+        let t_chunk = Instant::now();
+        match run.advance_frames(&times, &mut samples) {
+            Ok(frames) => batch.extend(frames),
+            Err(e) => {
+                let _ = out.send(SimMessage::Failed {
+                    generation,
+                    message: e.to_string(),
+                });
+                return RunEnd::Failed;
+            }
         }
+        chunk.took(t_chunk.elapsed());
+        // The cost of copying one frame set out, for the diagnostics panel (one extra
+        // copy per chunk: the chunk's own are made on the models' threads).
         let t_extract = Instant::now();
-        batch.push(run.frame_set());
+        let _ = run.frame_set();
         extract_total += t_extract.elapsed().as_secs_f64();
         extracted += 1;
-        next_frame += config.frame_dt;
+        next_frame += times.len() as u64;
+        let target = times.last().copied().unwrap_or(run.duration);
         let done = target >= run.duration - 1e-12;
         if done || last_send.elapsed() > Duration::from_millis(30) {
             let speed = target / start.elapsed().as_secs_f64().max(1e-9);
@@ -676,9 +728,69 @@ fn run_one(
     }
 }
 
+/// How many frames the simulation thread computes between two looks at its commands:
+/// the models' threads meet once per chunk, so a chunk should be long enough that the
+/// meeting costs little, and short enough that a new run (a slider dragged) replaces this
+/// one within a few hundredths of a second. Adapted to the measured time of the last one.
+struct FrameChunk {
+    frames: u64,
+}
+
+impl FrameChunk {
+    /// A chunk of at most this long, s (the UI's batch interval).
+    const TARGET: Duration = Duration::from_millis(20);
+    /// Frames per chunk at most (a model that computes fast).
+    const MAX_FRAMES: u64 = 64;
+
+    fn new() -> Self {
+        Self { frames: 1 }
+    }
+
+    /// The frame times of the next chunk, from frame number `first` (1-based, frame k at
+    /// k·`frame_dt`), the last one clipped to `duration`.
+    fn times(&self, first: u64, frame_dt: f64, duration: f64) -> Vec<f64> {
+        let mut times = Vec::with_capacity(self.frames as usize);
+        for k in first..first + self.frames {
+            let t = (k as f64 * frame_dt).min(duration);
+            times.push(t);
+            if t >= duration - 1e-12 {
+                break;
+            }
+        }
+        times
+    }
+
+    /// Grows the chunk while chunks take less than half the target, shrinks it while
+    /// they take more than the target.
+    fn took(&mut self, elapsed: Duration) {
+        if elapsed < Self::TARGET / 2 {
+            self.frames = (self.frames * 2).min(Self::MAX_FRAMES);
+        } else if elapsed > Self::TARGET {
+            self.frames = (self.frames / 2).max(1);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frame_chunks_grow_when_fast_shrink_when_slow_and_stop_at_the_end() {
+        let mut chunk = FrameChunk::new();
+        assert_eq!(chunk.times(1, 0.01, 10.0), vec![0.01]);
+        for _ in 0..10 {
+            chunk.took(Duration::from_millis(1));
+        }
+        assert_eq!(chunk.frames, FrameChunk::MAX_FRAMES);
+        chunk.took(Duration::from_millis(50));
+        assert_eq!(chunk.frames, FrameChunk::MAX_FRAMES / 2);
+        // Frame k at k·Δt (not a running sum); the last one clipped to the duration.
+        let times = chunk.times(995, 0.01, 10.0);
+        assert_eq!(times.len(), 6);
+        assert_eq!(times[0], 995.0 * 0.01);
+        assert_eq!(*times.last().unwrap(), 10.0);
+    }
 
     /// The thread publishes a started message, frames in time order up to the duration,
     /// and a finished message; a new Run replaces the current one.
