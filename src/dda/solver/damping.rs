@@ -196,10 +196,12 @@ impl Dda {
             }
         }
         let centroids = self.centroids();
-        for connection in &self.connections {
-            let terms = connection.terms();
-            let v = node_velocities(&terms, &centroids, &mean);
-            let u = node_velocities(&terms, &centroids, increments);
+        // The step's own connection terms (the joints have not moved since its assembly).
+        debug_assert!(self.elements_current);
+        let first_connection = self.bolts.len() + self.fixed.len();
+        for terms in &self.elements[first_connection..] {
+            let v = node_velocities(terms, &centroids, &mean);
+            let u = node_velocities(terms, &centroids, increments);
             let ke = terms.ke();
             let n = 2 * terms.nodes().len();
             for r in 0..n {
