@@ -22,8 +22,8 @@ const FRAME_INTERVAL: Duration = Duration::from_micros(16_667);
 /// While a run is being computed the window redraws at most this often (10 frames a
 /// second): its frames are drawn by the same cores that compute, and where they are drawn
 /// in software (Mesa's llvmpipe, a machine without a GPU) a frame costs ~50 ms of CPU.
-/// The default run then computes at ~21× real time in the window instead of ~17× at 30
-/// frames a second (docs/performance.md); the computation lasts a second or two.
+/// The default run then computes at 22–23× real time in the window instead of 17–18× at
+/// 30 frames a second (docs/performance.md); the computation lasts a second or two.
 const COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(100);
 
 struct App {
@@ -182,7 +182,7 @@ impl eframe::App for App {
         self.shell_requests(&ctx);
         self.frames_drawn += 1;
         if self.state.playing && self.state.animating() {
-            // Paced: the next frame no sooner than 1/60 s after this one began (1/20 s
+            // Paced: the next frame no sooner than 1/60 s after this one began (1/10 s
             // while the run is still being computed).
             let interval = if self.state.timeline.finished {
                 FRAME_INTERVAL

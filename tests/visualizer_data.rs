@@ -393,7 +393,8 @@ fn frames_advanced_in_chunks_equal_frames_advanced_one_by_one() {
     let mut samples_chunked = chunked.initial_samples();
     let mut frames_chunked = Vec::new();
     for chunk in times.chunks(37) {
-        frames_chunked.extend(chunked.advance_frames(chunk, &mut samples_chunked).unwrap());
+        let advanced = chunked.advance_frames(chunk, &mut samples_chunked).unwrap();
+        frames_chunked.extend(advanced.frames);
     }
     assert_eq!(frames_one.len(), frames_chunked.len());
     assert!(

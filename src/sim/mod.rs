@@ -297,6 +297,15 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
     })
 }
 
+/// What [`PreparedRun::advance_frames`] returns.
+#[derive(Debug, Clone)]
+pub struct AdvancedFrames {
+    /// One frame set per frame time.
+    pub frames: Vec<FrameSet>,
+    /// CPU time to copy one frame set out of the solvers (all models), s.
+    pub copy_s_per_frame: f64,
+}
+
 impl PreparedRun {
     /// The models' state now, as a frame set.
     pub fn frame_set(&self) -> FrameSet {
@@ -335,24 +344,31 @@ impl PreparedRun {
     /// Advances every model through the frame times `times` (increasing), appending one
     /// row per solver step to `samples`, and returns a frame set at each time. Each model
     /// runs through all of them on its own thread: the threads meet once per call, not
-    /// once per frame (the default scene's two frames on two cores: 1.43× faster than one
-    /// after the other with a meeting per frame, 1.8× with one per eight frames;
+    /// once per frame (the default scene's two frames on two cores, against one after the
+    /// other: 1.4× faster with a meeting per frame, 1.8× with one per 64 frames;
     /// docs/performance.md).
     pub fn advance_frames(
         &mut self,
         times: &[f64],
         samples: &mut [Samples],
-    ) -> Result<Vec<FrameSet>> {
+    ) -> Result<AdvancedFrames> {
         let per_model = self.on_each_model(samples, |dda, ex, s, motion| {
             let mut frames = Vec::with_capacity(times.len());
+            let mut copy_s = 0.0;
             for &t in times {
                 dda.run_until(t, |d, _| ex.sample(d, Some(motion), s))?;
+                let copy = Instant::now();
                 frames.push((dda.time(), ex.extract(dda, Some(motion))));
+                copy_s += copy.elapsed().as_secs_f64();
             }
-            Ok(frames)
+            Ok((frames, copy_s))
         })?;
-        let mut columns: Vec<_> = per_model.into_iter().map(Vec::into_iter).collect();
-        Ok(times
+        let copy_s: f64 = per_model.iter().map(|(_, s)| s).sum();
+        let mut columns: Vec<_> = per_model
+            .into_iter()
+            .map(|(frames, _)| frames.into_iter())
+            .collect();
+        let frames = times
             .iter()
             .map(|&t| {
                 let row: Vec<_> = columns.iter_mut().filter_map(Iterator::next).collect();
@@ -361,7 +377,11 @@ impl PreparedRun {
                     models: row.into_iter().map(|r| r.1).collect(),
                 }
             })
-            .collect())
+            .collect();
+        Ok(AdvancedFrames {
+            frames,
+            copy_s_per_frame: copy_s / times.len().max(1) as f64,
+        })
     }
 
     /// Runs `work` on every model, each on its own scoped thread (the first on this one),
@@ -667,7 +687,7 @@ fn run_one(
     let _ = out.send(run.started_message(generation, config));
     let mut batch = Vec::new();
     let mut last_send = Instant::now();
-    let (mut extract_total, mut extracted) = (0.0, 0u64);
+    let (mut copy_total, mut copies) = (0.0, 0u64);
     let mut next_frame = 1u64;
     let mut chunk = FrameChunk::new();
     loop {
@@ -680,7 +700,11 @@ fn run_one(
         let times = chunk.times(next_frame, config.frame_dt, run.duration);
         let t_chunk = Instant::now();
         match run.advance_frames(&times, &mut samples) {
-            Ok(frames) => batch.extend(frames),
+            Ok(advanced) => {
+                batch.extend(advanced.frames);
+                copy_total += advanced.copy_s_per_frame;
+                copies += 1;
+            }
             Err(e) => {
                 let _ = out.send(SimMessage::Failed {
                     generation,
@@ -690,18 +714,12 @@ fn run_one(
             }
         }
         chunk.took(t_chunk.elapsed());
-        // The cost of copying one frame set out, for the diagnostics panel (one extra
-        // copy per chunk: the chunk's own are made on the models' threads).
-        let t_extract = Instant::now();
-        let _ = run.frame_set();
-        extract_total += t_extract.elapsed().as_secs_f64();
-        extracted += 1;
         next_frame += times.len() as u64;
         let target = times.last().copied().unwrap_or(run.duration);
         let done = target >= run.duration - 1e-12;
         if done || last_send.elapsed() > Duration::from_millis(30) {
             let speed = target / start.elapsed().as_secs_f64().max(1e-9);
-            let extract_us = 1e6 * extract_total / extracted.max(1) as f64;
+            let extract_us = 1e6 * copy_total / copies.max(1) as f64;
             let frames = std::mem::take(&mut batch);
             let fresh = samples.iter_mut().map(std::mem::take).collect();
             if out

@@ -87,6 +87,12 @@ impl Dda {
         rows
     }
 
+    /// The connections' part of the joints' terms (listed after the bolts' and fixed
+    /// points', as [`Dda::element_terms_into`] lists them).
+    fn connection_terms<'a>(&self, elements: &'a [ElementTerms]) -> &'a [ElementTerms] {
+        &elements[self.bolts.len() + self.fixed.len()..]
+    }
+
     /// Adds the structure's damping to a dynamic step's system: its scalar dashpots and
     /// Rayleigh's stiffness-proportional part. `elements` are the step's joint terms
     /// (bolts, fixed points, then connections, as [`Dda::element_terms_into`] lists them).
@@ -149,8 +155,7 @@ impl Dda {
         let centroids = self.centroids();
         // The ground stands still in the moving frame: its known increment is zero here.
         let still: PerBlock<Vec6> = self.blocks.iter().map(|_| [0.0; 6]).collect();
-        let first_connection = self.bolts.len() + self.fixed.len();
-        for terms in &elements[first_connection..] {
+        for terms in self.connection_terms(elements) {
             let velocities = node_velocities(terms, &centroids, &predicted);
             let damped = terms.as_dashpot(a1, gain, &velocities);
             sys.add_nodal_element(&self.dofs, &still, &centroids, &damped);
@@ -198,8 +203,7 @@ impl Dda {
         let centroids = self.centroids();
         // The step's own connection terms (the joints have not moved since its assembly).
         debug_assert!(self.elements_current);
-        let first_connection = self.bolts.len() + self.fixed.len();
-        for terms in &self.elements[first_connection..] {
+        for terms in self.connection_terms(&self.elements) {
             let v = node_velocities(terms, &centroids, &mean);
             let u = node_velocities(terms, &centroids, increments);
             let ke = terms.ke();
