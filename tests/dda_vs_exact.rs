@@ -104,7 +104,11 @@ fn dda_matches_the_exact_model_on_representative_points() {
 #[test]
 #[ignore]
 fn full_paper_grid_meets_the_targets() {
-    for integrator in ["trapezoidal", "generalized-alpha:0"] {
+    for integrator in [
+        "trapezoidal",
+        "generalized-alpha:0",
+        "generalized-alpha:0.5",
+    ] {
         let (t, residuals) = sweep_with(
             vec![0.1, 0.5, 0.9],
             vec![0.01, 0.05, 0.1, 0.25],
@@ -113,10 +117,13 @@ fn full_paper_grid_meets_the_targets() {
             Integrator::parse(integrator).unwrap(),
         );
         println!("{integrator}:\n{t}");
-        let dissipative = integrator != "trapezoidal";
+        // ρ∞ = 0's largest slip error (6.2 % at Ω/ω = 10) is its truncation error on the
+        // ground's displacement, which the slip is a small difference from; see
+        // docs/validation.md. Every other member of the family meets all the targets.
+        let annihilating = integrator == "generalized-alpha:0";
         for (k, m) in t.metrics.iter().enumerate() {
             assert_eq!(m.count, 300);
-            let max_checked = !(dissipative && k == 0);
+            let max_checked = !(annihilating && k == 0);
             assert!(
                 m.median <= 1e-3 && m.p90 <= 5e-3 && (!max_checked || m.max <= 0.02),
                 "{integrator}, {}: median {:.3} %, 90th {:.3} %, max {:.3} % at {:?}",
@@ -127,7 +134,7 @@ fn full_paper_grid_meets_the_targets() {
                 m.worst
             );
         }
-        if !dissipative {
+        if !annihilating {
             let mut r = residuals.clone();
             r.sort_by(f64::total_cmp);
             let (median, max) = (r[r.len() / 2], r[r.len() - 1]);
@@ -206,6 +213,42 @@ fn dda_and_exact(
     let run = run_dda(&setup, &setup.scene, adjust(setup.solver_params())).unwrap();
     let exact = run_exact_two_block(&setup, 0.0).unwrap();
     (run, exact)
+}
+
+/// With 0 < ρ∞ < 1 the generalised-α scheme once balanced the forces at its α point: a
+/// contact's force was then an average over two instants, the first slip of a light raft
+/// at Ω/ω = 10 was found 1/(1 − αf) late (0.88 ms instead of 0.59 ms at ρ∞ = 0.5), with
+/// the stuck base's acceleration past what friction can hold (a_base +35 % at ρ∞ = 0.5,
+/// +53 % at 0.8), and the friction work booked at the end did not match the force
+/// applied (energy residual −5e-4). Balanced at the step's end (Arnold and Brüls' form),
+/// every scheme of the family finds the exact model's peak base acceleration within
+/// 0.1 % (it is reached at the first slip, where friction lets go), and the ledger
+/// closes to round-off.
+#[test]
+fn every_generalised_alpha_scheme_finds_the_first_slip() {
+    for integrator in ["generalized-alpha:0.5", "generalized-alpha:0.8", "hht:0.1"] {
+        let spec = RunSpec {
+            alpha: Some(0.1),
+            friction: Some(0.01),
+            excitation: ExcitationSpec::ratio(10.0),
+            duration: Some(2.0),
+            integrator: Some(Integrator::parse(integrator).unwrap()),
+            ..RunSpec::default()
+        };
+        let (run, exact) = dda_and_exact(spec, |p| p);
+        let error = (run.peaks.base_accel - exact.peaks.base_accel).abs() / exact.peaks.base_accel;
+        assert!(
+            error < 1e-3,
+            "{integrator}: a_base {} vs exact {} (error {error:.1e})",
+            run.peaks.base_accel,
+            exact.peaks.base_accel
+        );
+        assert!(
+            run.energy_residual_rel.abs() < 1e-8,
+            "{integrator}: energy residual {:.1e}",
+            run.energy_residual_rel
+        );
+    }
 }
 
 /// `restart_after_events = false` once spun forever at t ≈ 14.2 s of the default run (an

@@ -110,8 +110,8 @@ pub struct Contact {
     pub flips: u32,
     /// Normal force used for friction in the current pass, N.
     pub friction_normal: f64,
-    /// Sliding friction coefficient used in the current pass (the law's, at the slip speed
-    /// of the previous pass's α point).
+    /// Sliding friction coefficient used in the current pass (the law's, at the end slip
+    /// speed of the previous pass).
     pub sliding_coefficient: f64,
     /// Normal force at the step start (from the contact memory), N.
     pub start_normal: f64,

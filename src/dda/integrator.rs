@@ -9,16 +9,31 @@
 //! v₁ = v₀ + Δt [(1 − γ) a₀ + γ a₁]
 //! ```
 //!
-//! and the equilibrium is taken at the α points: `M [(1 − αm) a₁ + αm a₀]` against the
-//! forces at `t + (1 − αf)Δt`.
+//! and the forces are balanced at the step's end, in the form Arnold and Brüls (2007)
+//! give the generalised-α scheme for constrained systems:
+//!
+//! ```text
+//! M q̈₁ = F(t + Δt),   (1 − αf) q̈₁ + αf q̈₀ = (1 − αm) a₁ + αm a₀
+//! ```
+//!
+//! `q̈` is the acceleration that balances the forces (what the solver reports), `a` the
+//! scheme's own acceleration variable. For a linear model that starts in balance this is
+//! Chung and Hulbert's scheme (forces at `t + (1 − αf)Δt`) to the step, with the same
+//! spectral radius; unlike it, every force — contact multipliers, friction, dashpots —
+//! is a force at the step's end, so a contact's force, the events found from it and the
+//! energy booked from it do not mix two instants. (Written with the forces at the α
+//! point, a contact that changed state inside a step left an error in the balanced
+//! accelerations that only decayed by −αf/(1 − αf) per step: +35 % in a peak base
+//! acceleration at ρ∞ = 0.5.)
 
 use super::params::AlphaCoefficients;
 
 /// The generalised-α relations, for one unknown at a time.
 impl AlphaCoefficients {
-    /// The factor of the mass matrix in the step's system: `(1 − αm)/(βΔt²)`.
+    /// The factor of the mass matrix in the step's system, `(1 − αm)/((1 − αf)βΔt²)`:
+    /// how the balanced end acceleration grows with the increment.
     pub fn mass_factor(&self, dt: f64) -> f64 {
-        (1.0 - self.alpha_m) / (self.beta * dt * dt)
+        (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
     }
 
     /// The end acceleration less its increment-proportional part `d/(βΔt²)`:
@@ -44,18 +59,20 @@ impl AlphaCoefficients {
         self.end_velocity(v0, a0, a_from_rest, dt)
     }
 
-    /// The inertia the step's equilibrium balances, less its increment-proportional part:
-    /// `(1 − αm) ã + αm a₀`.
-    pub fn inertia_predictor(&self, v0: f64, a0: f64, dt: f64) -> f64 {
-        (1.0 - self.alpha_m) * self.accel_predictor(v0, a0, dt) + self.alpha_m * a0
+    /// The balanced end acceleration less its increment-proportional part:
+    /// `[(1 − αm) ã + αm a₀ − αf q̈₀]/(1 − αf)`, with `balanced0` the balanced acceleration
+    /// `q̈₀` at the step's start.
+    pub fn inertia_predictor(&self, v0: f64, a0: f64, balanced0: f64, dt: f64) -> f64 {
+        let filtered = (1.0 - self.alpha_m) * self.accel_predictor(v0, a0, dt) + self.alpha_m * a0
+            - self.alpha_f * balanced0;
+        filtered / (1.0 - self.alpha_f)
     }
 
     /// The acceleration that balances the forces at the step's end, from the scheme's
-    /// end acceleration `a1`, its start `a0` and the balanced acceleration at the start.
-    ///
-    /// The step balanced the forces at `t + (1 − αf)Δt` against `(1 − αm)a₁ + αm a₀`;
-    /// unfolding the αf-average gives the acceleration that balances them at `t + Δt`
-    /// (the scheme's `a₁` itself lags by `(αf − αm)Δt`: a whole step for ρ∞ = 0).
+    /// end acceleration `a1`, its start `a0` and the balanced acceleration at the start:
+    /// `q̈₁ = [(1 − αm) a₁ + αm a₀ − αf q̈₀]/(1 − αf)`, what the step's equilibrium was
+    /// solved for (the scheme's `a₁` itself lags by `(αf − αm)Δt`: a whole step for
+    /// ρ∞ = 0).
     pub fn balanced_accel(&self, a0: f64, a1: f64, balanced0: f64) -> f64 {
         let balanced = (1.0 - self.alpha_m) * a1 + self.alpha_m * a0;
         (balanced - self.alpha_f * balanced0) / (1.0 - self.alpha_f)
@@ -67,12 +84,13 @@ mod tests {
     use crate::dda::Integrator;
     use crate::dda::params::AlphaCoefficients;
 
-    /// One step of the oscillator u'' + ω²u = 0: the equilibrium at the α points solved for
-    /// the increment, the end state from the relations above. Returns (u, v, a, balanced).
+    /// One step of the oscillator u'' + ω²u = 0: the equilibrium at the step's end solved
+    /// for the increment, the end state from the relations above. Returns (u, v, a,
+    /// balanced).
     fn step(c: &AlphaCoefficients, w2: f64, dt: f64, s: [f64; 4]) -> [f64; 4] {
         let [u0, v0, a0, r0] = s;
-        let stiffness = c.mass_factor(dt) + (1.0 - c.alpha_f) * w2;
-        let d = -(c.inertia_predictor(v0, a0, dt) + w2 * u0) / stiffness;
+        let stiffness = c.mass_factor(dt) + w2;
+        let d = -(c.inertia_predictor(v0, a0, r0, dt) + w2 * u0) / stiffness;
         let a1 = c.end_accel(d, v0, a0, dt);
         [
             u0 + d,

@@ -5,9 +5,11 @@ use serde::{Deserialize, Serialize};
 use crate::{Error, Result};
 
 /// Time integration scheme. All are members of the generalised-α family
-/// (Chung & Hulbert 1993), which contains Newmark's family as αm = αf = 0:
-///
-/// `M a(n+1−αm) + f_int(d(n+1−αf)) = f_ext(t(n+1−αf))`, with Newmark updates (β, γ).
+/// (Chung & Hulbert 1993), which contains Newmark's family as αm = αf = 0, written as
+/// Arnold & Brüls (2007) do for constrained systems: the forces are balanced at the step's
+/// end, `M q̈(n+1) = f(t(n+1))`, and the scheme's acceleration variable follows
+/// `(1−αm) a(n+1) + αm a(n) = (1−αf) q̈(n+1) + αf q̈(n)`, with Newmark updates (β, γ) on
+/// `a` (see `dda::integrator`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum Integrator {

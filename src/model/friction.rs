@@ -54,8 +54,8 @@ pub enum Friction {
 ///
 /// The open-close judge compares a stuck contact's tangential force with the sticking
 /// coefficient times N; a sliding contact carries the sliding coefficient at its slip speed
-/// times N, evaluated at the integrator's α point and iterated within the step like the
-/// normal force it multiplies (docs/friction-laws.md).
+/// times N, evaluated at the step's end (where the integrator balances the forces) and
+/// iterated within the step like the normal force it multiplies (docs/friction-laws.md).
 pub trait FrictionLaw {
     /// Coefficient of the largest tangential force a stuck contact holds, per unit normal
     /// force (+∞: never slides; 0: always slides).

@@ -1,10 +1,10 @@
 //! The structure's own damping in a step: the bolts' dashpots and Rayleigh damping (see
 //! [`crate::dda::rayleigh`]), assembled into the step's system and booked in the ledger.
 //!
-//! Every damping force is c·v at the generalised-α point, with the end velocity of a free
-//! block from the Newmark update, v₁ = γ/(βΔt)·D + w (linear in the increment D), so a
-//! dashpot adds (1 − αf)·c·γ/(βΔt) to the stiffness and its predictor part to the
-//! right-hand side. The ledger books, like every other force, the average of the force at
+//! Every damping force is c·v at the step's end (where the integrator balances every
+//! force), with the end velocity of a free block from the Newmark update,
+//! v₁ = γ/(βΔt)·D + w (linear in the increment D), so a dashpot adds c·γ/(βΔt) to the
+//! stiffness and its predictor part to the right-hand side. The ledger books, like every other force, the average of the force at
 //! the step's two ends times the increment.
 
 use super::*;
@@ -120,16 +120,15 @@ impl Dda {
         }
         let co = &self.coeffs;
         let gain = co.gamma / (co.beta * dt);
-        // The α-point velocity less its increment part: (1 − αf)·w + αf·v₀.
+        // The end velocity less its increment part.
         let predicted: PerBlock<Vec6> = self
             .blocks
             .iter()
             .enumerate()
             .map(|(bi, b)| match self.dofs.slot[bi] {
-                Some(_) => std::array::from_fn(|k| {
-                    let w = co.velocity_predictor(b.velocity[k], b.accel[k], dt);
-                    (1.0 - co.alpha_f) * w + co.alpha_f * b.velocity[k]
-                }),
+                Some(_) => {
+                    std::array::from_fn(|k| co.velocity_predictor(b.velocity[k], b.accel[k], dt))
+                }
                 None => [0.0; 6],
             })
             .collect();

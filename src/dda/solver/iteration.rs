@@ -30,10 +30,6 @@ impl Dda {
         known: &[Vec6],
         base: &System,
     ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
-        let alpha_f = match mode {
-            Mode::Dynamic { .. } => self.coeffs.alpha_f,
-            Mode::Static { .. } | Mode::Modal => 0.0,
-        };
         // A closed contact whose gap opens by less than this stays closed (so that one
         // resting at zero force does not flicker). Its spring then pulls, by at most
         // p·tolerance: 1e-12 of the size keeps that tension far below any force of
@@ -109,40 +105,38 @@ impl Dda {
                     open_tolerance,
                     slip_tolerance,
                 });
-                // Friction acts with the normal force at the generalised-α time point.
-                let n_alpha = if augmented && c.state.is_closed() {
-                    alpha_f * c.start_normal + (1.0 - alpha_f) * normal_force
+                // Friction acts with the normal force at the step's end, where every force
+                // of the step is balanced (see the integrator).
+                let n_end = if augmented && c.state.is_closed() {
+                    normal_force
                 } else {
-                    let gap_alpha = alpha_f * c.gap0 + (1.0 - alpha_f) * gap;
-                    p * (-gap_alpha).max(0.0)
+                    p * (-gap).max(0.0)
                 };
                 // The friction force uses the normal force of the previous pass (keeping K
                 // symmetric); iterate until it moves by < 1e-4: the friction force is then
                 // within 1e-4·ρN of the implicit one, far below the accuracy targets, while a
                 // tighter bound only buys passes when the penalty springs ring.
-                // The sliding coefficient, at the α point's slip speed, settles the same way.
-                let mu_alpha = match mode {
+                // The sliding coefficient, at the end's slip speed, settles the same way.
+                let mu_end = match mode {
                     Mode::Static { friction: Some(f) } => f,
-                    _ => c.props.friction.sliding_coefficient(
-                        alpha_f * c.start_slip_velocity + (1.0 - alpha_f) * slip_velocity,
-                    ),
+                    _ => c.props.friction.sliding_coefficient(slip_velocity),
                 };
                 let sliding = matches!(new_state, ContactState::Sliding { .. });
-                let mu_moved = (mu_alpha - c.sliding_coefficient).abs()
-                    > 1e-4 * mu_alpha.max(c.sliding_coefficient);
+                let mu_moved = (mu_end - c.sliding_coefficient).abs()
+                    > 1e-4 * mu_end.max(c.sliding_coefficient);
                 if sliding
                     && (mu_moved
-                        || (n_alpha - c.friction_normal).abs() > 1e-4 * max_normal.max(n_alpha))
+                        || (n_end - c.friction_normal).abs() > 1e-4 * max_normal.max(n_end))
                 {
                     changed = true;
                 }
-                c.friction_normal = n_alpha;
+                c.friction_normal = n_end;
                 // A coefficient within the tolerance is left as the solve used it, so that
                 // the friction work booked and the force carried into the next step are
                 // the ones the step was solved with (the energy balance of a velocity law
                 // closed to 1e-6 only when the settled pass's re-evaluation was booked).
                 if mu_moved || !sliding {
-                    c.sliding_coefficient = mu_alpha;
+                    c.sliding_coefficient = mu_end;
                 }
                 // A contact that keeps flipping within one step (stuck ↔ sliding with the
                 // penalty spring's unresolved dynamics on either side of the limit) keeps

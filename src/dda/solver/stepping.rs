@@ -83,7 +83,7 @@ impl Dda {
                     ContactState::Locked => (stuck_stretch, normal, c.shear_multiplier),
                     ContactState::Sliding { direction } => {
                         // A speed-dependent law: the coefficient the step was solved with (at
-                        // the α point, as iterated), so that the next step starts from the
+                        // the end slip speed, as iterated), so that the next step starts from the
                         // force this one used and booked. (A constant law's own value also
                         // after a settle that overrode it: see NOTES-issue-13.)
                         let mu = if c.props.friction.depends_on_speed() {
@@ -436,10 +436,9 @@ impl Dda {
         }
         // Dashpots: like every other force of the ledger, the average of the force at the
         // step's two ends, c·½(q̇₀ + q̇₁), times the relative displacement. (The force at
-        // the α point, which the step applies, differs from it by what the integrator
-        // dissipates, and that is its own term; booking the α-point force left the
-        // damped two-block's balance off by 3e-6, stuck steps gaining what sliding ones
-        // lost.)
+        // the end, which the step applies, differs from it by what the integrator
+        // dissipates, and that is its own term; booking the end force left the damped
+        // two-block's balance off by 3e-6, stuck steps gaining what sliding ones lost.)
         let mut damped = 0.0;
         for ct in &self.contacts {
             let (cn, cs) = self.dashpot_coefficients(ct);

@@ -51,7 +51,8 @@ impl Dda {
     ) {
         let c = &self.coeffs;
         let (mass_factor, stiffness_factor) = match mode {
-            Mode::Dynamic { dt } => (c.mass_factor(dt), 1.0 - c.alpha_f),
+            // Every force at the step's end (see the integrator): the stiffness is whole.
+            Mode::Dynamic { dt } => (c.mass_factor(dt), 1.0),
             // A vanishing "mass spring" (1 mHz) only so that unloaded rigid-body modes (a
             // roof hung on one bolt can still turn) do not make the static matrix singular.
             Mode::Static { .. } => ((2.0 * std::f64::consts::PI * 1e-3_f64).powi(2), 1.0),
@@ -77,10 +78,11 @@ impl Dda {
             // Gravity.
             sys.r[s + 1] -= b.total_mass() * self.gravity;
             if let Mode::Dynamic { dt } = mode {
-                // Inertia from the previous step: −M[(1 − αm) ã + αm a].
+                // Inertia from the previous step: the balanced end acceleration's part
+                // that does not grow with the increment.
                 let mut w = [0.0; 6];
                 for k in 0..6 {
-                    w[k] = c.inertia_predictor(b.velocity[k], b.accel[k], dt);
+                    w[k] = c.inertia_predictor(b.velocity[k], b.accel[k], b.response_accel[k], dt);
                 }
                 for i in 0..6 {
                     let mw: f64 = (0..6).map(|j| b.mass[i][j] * w[j]).sum();
@@ -90,8 +92,7 @@ impl Dda {
                 // components when the ground also shakes vertically). The paper's
                 // large-mass ground is driven by f = m_g ü0 (eq. 4), which cancels it.
                 if b.role != BlockRole::LargeMassGround {
-                    let t_alpha = self.time + (1.0 - c.alpha_f) * dt;
-                    let [ax, ay] = self.frame_accel(t_alpha);
+                    let [ax, ay] = self.frame_accel(self.time + dt);
                     sys.r[s] -= b.total_mass() * ax;
                     sys.r[s + 1] -= b.total_mass() * ay;
                 }
@@ -207,7 +208,7 @@ impl Dda {
     }
 
     /// Adds a dashpot of coefficient `damping` on the relative velocity q = a·v_i + b·v_j:
-    /// force c·q at the generalised-α point, with the velocity of a free block from the
+    /// force c·q at the step's end, with the velocity of a free block from the
     /// Newmark update (linear in the increment) and that of the prescribed ground (which
     /// stands still in the moving frame) zero.
     pub(super) fn add_dashpot(
@@ -232,8 +233,7 @@ impl Dda {
                 for k in 0..6 {
                     w[k] = co.velocity_predictor(bl.velocity[k], bl.accel[k], dt);
                 }
-                f0 += damping
-                    * ((1.0 - co.alpha_f) * dot6(vec, &w) + co.alpha_f * dot6(vec, &bl.velocity));
+                f0 += damping * dot6(vec, &w);
                 parts.push((blk, vec));
             }
         }
