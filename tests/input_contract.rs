@@ -374,6 +374,35 @@ fn points_far_outside_their_blocks_are_refused() {
     );
 }
 
+/// A dish's arc must be what it says: chords of its circle, a run of the polygon's edges,
+/// its centre on the free side. Otherwise the contacts would slide on a circle the block
+/// does not have.
+#[test]
+fn an_arc_that_is_not_its_blocks_edges_is_refused() {
+    let ground = "vertices = [[-2000.0, -1.0], [2000.0, -1.0], [2000.0, 0.0], [-2000.0, 0.0]]";
+    let with_arc = |arc: &str| TWO_BLOCK.replace(ground, &format!("{ground}\narcs = [{arc}]"));
+    let off = scene_error(&with_arc(
+        "{ center = [0.0, 10.0], radius = 10.0, edges = [2, 2] }",
+    ));
+    assert_has(
+        &off,
+        &[
+            "s.toml:28",
+            "arc 1",
+            "off the circle",
+            "chords of its circle",
+        ],
+    );
+    let beyond = scene_error(&with_arc(
+        "{ center = [0.0, 10.0], radius = 10.0, edges = [2, 9] }",
+    ));
+    assert_has(&beyond, &["arc 1", "edges [2, 9]", "edges 0 to 3"]);
+    let flat = scene_error(&with_arc(
+        "{ center = [0.0, 1.0], radius = -1.0, edges = [2, 2] }",
+    ));
+    assert_has(&flat, &["positive radius"]);
+}
+
 #[test]
 fn an_empty_block_name_is_refused() {
     let text = TWO_BLOCK

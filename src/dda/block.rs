@@ -4,6 +4,8 @@ use crate::Result;
 use crate::model::geometry::{self, Moments, Point};
 use crate::model::material::Material;
 
+use super::surface::CircularArc;
+
 /// Six block unknowns `(u0, v0, r0, εx, εy, γxy)` or a 6-vector of generalised forces.
 pub type Vec6 = [f64; 6];
 /// A 6×6 block of the global matrix.
@@ -248,6 +250,9 @@ pub struct Block {
     /// Elastic energy stored in the block's strains, J per unit thickness: the work of
     /// its stresses on the strain increments (see [`Block::strain_energy`]).
     pub elastic_energy: f64,
+    /// Runs of edges that are chords of a circle (a dish), which contacts see as the
+    /// circle itself (see [`crate::dda::surface`]).
+    pub arcs: Vec<CircularArc>,
 }
 
 impl Block {
@@ -278,6 +283,7 @@ impl Block {
             rigid: false,
             rest_area: moments.area,
             elastic_energy: 0.0,
+            arcs: Vec::new(),
         })
     }
 
@@ -325,6 +331,18 @@ impl Block {
         0.5 * w
     }
 
+    /// A free block of unit density and stiffness (the geometry tests' block).
+    #[cfg(test)]
+    pub(crate) fn unit_for_tests(vertices: Vec<Point>) -> Self {
+        let material = Material {
+            density: 1.0,
+            youngs_modulus: 1.0,
+            poisson_ratio: 0.0,
+            plane: Default::default(),
+        };
+        Self::new("b", vertices, material, BlockRole::Free).expect("a valid test polygon")
+    }
+
     /// Moves the block by the step's unknowns `d`: vertices, stress, strain, moments and
     /// mass matrix are updated; velocity and acceleration are set by the integrator.
     pub fn apply_increment(&mut self, d: &Vec6, exact_rotation: bool) -> Result<()> {
@@ -335,6 +353,13 @@ impl Block {
             let u = displacement_with_rotation(c, *p, d, rotation);
             p[0] += u[0];
             p[1] += u[1];
+        }
+        // An arc's centre moves as a material point (its radius is kept: the strain of a
+        // dish, a ground block, is far below what would change its curvature).
+        for arc in &mut self.arcs {
+            let u = displacement_with_rotation(c, arc.center, d, rotation);
+            arc.center[0] += u[0];
+            arc.center[1] += u[1];
         }
         let de = [d[3], d[4], d[5]];
         // The work of the step's strain forces S(σ + ½CΔε) on Δε (trapezoidal in σ, exact

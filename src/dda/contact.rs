@@ -1,19 +1,16 @@
 //! Vertex-edge contacts: detection, persistent state, and the linearised gap and slip.
 //!
 //! Vertex P1 of block i against edge P2→P3 of block j (counter-clockwise polygons, so the
-//! edge's outward normal n̂ is to the right of its direction t̂). With w = P1 − P2 and
-//! l = |P3 − P2|:
-//!
-//! - gap `d = n̂·w = (w × (P3 − P2))/l`, negative when P1 penetrates; linearised in the
-//!   step's unknowns: `d = d0 + e·D_i + g·D_j` with `e = T_i(P1)ᵀ n̂` and
-//!   `g = [T_j(P2)ᵀ perp(w − e) − T_j(P3)ᵀ perp(w)]/l`, perp(a) = (a_y, −a_x) — the
-//!   first-order change of the signed area, including the edge's own rotation.
-//! - slip `Δs = t̂·(T_i(P1) D_i − T_j(Q) D_j)`, Q the material point of the edge under P1.
+//! edge's outward normal n̂ is to the right of its direction t̂). The gap (negative when P1
+//! penetrates) and the slip along t̂, linearised in the step's unknowns, come from the
+//! surface the edge belongs to — the edge itself, or the circle of a dish whose chord it
+//! is ([`super::surface`]).
 
 use rustc_hash::FxHashMap;
 
-use super::block::{Block, EdgeFrame, Vec6, t_transpose_times};
+use super::block::{Block, EdgeFrame, Vec6};
 use super::judge::ContactState;
+use super::surface::{self, SurfaceFrame};
 use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::geometry::{Point, contains, cross, dot, sub};
 
@@ -137,6 +134,9 @@ pub struct Contact {
     pub point: Point,
     /// Edge unit tangent t̂.
     pub tangent: Point,
+    /// Curvature of the surface under the vertex, 1/m (0 on a flat edge; see
+    /// [`SurfaceFrame::curvature`]).
+    pub curvature: f64,
 }
 
 impl Contact {
@@ -177,11 +177,6 @@ impl Contact {
 #[inline]
 pub fn dot6(a: &Vec6, b: &Vec6) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
-}
-
-#[inline]
-fn perp(a: Point) -> Point {
-    [a[1], -a[0]]
 }
 
 /// Axis-aligned bounding box (min, max).
@@ -244,6 +239,38 @@ pub fn detect(
         }
         out.truncate(write);
     }
+}
+
+/// The edge a contact on edge `k` of `block` is known by: an arc's first edge for any of
+/// its chords (the contact is with the circle, and keeps its memory however many facets a
+/// step crosses: a slider at 1.4 m/s crosses more than one 1.4 mm facet per step), else
+/// `k` itself.
+fn surface_edge(block: &Block, k: usize) -> usize {
+    block
+        .arcs
+        .iter()
+        .find(|a| a.holds_edge(k))
+        .map_or(k, |a| a.edges[0])
+}
+
+/// What the contact `key` remembers from the last step: its own memory, or, for a vertex
+/// that moved on to the neighbouring edge of the same block (`edges` edges), that edge's
+/// memory if it was closed — the vertex keeps its state and forces.
+pub fn remembered(
+    memory: &ContactMemories,
+    key: ContactKey,
+    edges: usize,
+) -> Option<ContactMemory> {
+    memory.get(&key).copied().or_else(|| {
+        [(key.edge + 1) % edges, (key.edge + edges - 1) % edges]
+            .iter()
+            .find_map(|&other| {
+                memory
+                    .get(&ContactKey { edge: other, ..key })
+                    .copied()
+                    .filter(|m| m.state.is_closed())
+            })
+    })
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -314,7 +341,7 @@ fn detect_one_way(
                 vertex_block: vb,
                 vertex: vi,
                 edge_block: eb,
-                edge: ek,
+                edge: surface_edge(eblock, ek),
             };
             let known = memory.contains_key(&key);
             let better = match best {
@@ -330,20 +357,9 @@ fn detect_one_way(
             vertex_block: vb,
             vertex: vi,
             edge_block: eb,
-            edge: ek,
+            edge: surface_edge(eblock, ek),
         };
-        // Carry the memory over; a vertex that moved on to the neighbouring edge of the
-        // same block keeps its state.
-        let mem = memory.get(&key).copied().or_else(|| {
-            [(ek + 1) % ne, (ek + ne - 1) % ne]
-                .iter()
-                .find_map(|&other| {
-                    memory
-                        .get(&ContactKey { edge: other, ..key })
-                        .copied()
-                        .filter(|m| m.state.is_closed())
-                })
-        });
+        let mem = remembered(memory, key, ne);
         out.push(linearise(vblock, eblock, key, pair, props, mem));
     }
 }
@@ -357,31 +373,16 @@ fn linearise(
     props: JointProps,
     mem: Option<ContactMemory>,
 ) -> Contact {
-    let ne = eblock.vertices.len();
     let p1 = vblock.vertices[key.vertex];
-    let p2 = eblock.vertices[key.edge];
-    let p3 = eblock.vertices[(key.edge + 1) % ne];
-    let e = sub(p3, p2);
-    let EdgeFrame {
+    let SurfaceFrame {
+        gap0,
+        gap_i,
+        gap_j,
+        slip_i,
+        slip_j,
         tangent: t,
-        normal: n,
-        length: l,
-    } = eblock.edges[key.edge];
-    let w = sub(p1, p2);
-    let gap0 = cross(w, e) / l;
-    let ci = vblock.moments.centroid;
-    let cj = eblock.moments.centroid;
-    let gap_i = t_transpose_times(ci, p1, n);
-    let a = t_transpose_times(cj, p2, perp(sub(w, e)));
-    let b = t_transpose_times(cj, p3, perp(w));
-    let mut gap_j = [0.0; 6];
-    for k in 0..6 {
-        gap_j[k] = (a[k] - b[k]) / l;
-    }
-    let q = [p2[0] + dot(w, t) * t[0], p2[1] + dot(w, t) * t[1]];
-    let slip_i = t_transpose_times(ci, p1, t);
-    let tq = t_transpose_times(cj, q, t);
-    let slip_j = tq.map(|v| -v);
+        curvature,
+    } = surface::frame(vblock, eblock, p1, key.edge);
     let shear_change = mem.map_or(0.0, |m| m.shear_change);
     let (start_state, shear0, normal, normal_change, shear_multiplier) = match mem {
         // The shear spring is elastic-perfectly-plastic: while sliding it stays stretched
@@ -446,23 +447,17 @@ fn linearise(
         previous_shear_change: shear_change,
         point: p1,
         tangent: t,
+        curvature,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dda::block::{BlockRole, point_displacement};
-    use crate::model::material::Material;
+    use crate::dda::block::point_displacement;
 
     fn block(v: Vec<Point>) -> Block {
-        let m = Material {
-            density: 1.0,
-            youngs_modulus: 1.0,
-            poisson_ratio: 0.0,
-            plane: Default::default(),
-        };
-        Block::new("b", v, m, BlockRole::Free).unwrap()
+        Block::unit_for_tests(v)
     }
 
     /// The linearised gap matches the exact gap after small motions of both blocks.

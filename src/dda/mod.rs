@@ -18,6 +18,7 @@ pub mod linear;
 pub mod params;
 pub mod rayleigh;
 pub mod solver;
+pub mod surface;
 
 pub use crate::model::friction::FrictionLaw;
 pub use energy::EnergyTerms;

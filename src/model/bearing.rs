@@ -15,7 +15,7 @@
 //! it rests on the facet and not on a kink. The ground outside the dishes is lowered by
 //! [`CLEARANCE_M`] below the slab, so that only the feet touch it.
 
-use super::scene::{BlockDef, Scene};
+use super::scene::{ArcDef, BlockDef, Scene};
 use crate::{Error, Result};
 
 /// The bearing under a frame's base slab.
@@ -150,9 +150,11 @@ pub fn apply_pendulum_bearings(
     let ground_vertices = dished_ground([gx0, gx1], top, bottom, radius, half_angle, centres);
     let tip = bottom + 1.5 * chord_sag(radius, half_angle);
     let slab_vertices = footed_slab([x0, y0, x1, y1], tip, centres);
+    let arcs = dish_arcs(bottom + radius, radius, centres);
     for b in &mut scene.blocks {
         if b.name == ground {
             b.vertices = ground_vertices.clone();
+            b.arcs = arcs.clone();
         } else if b.name == base {
             b.vertices = slab_vertices.clone();
         }
@@ -212,6 +214,22 @@ fn dished_ground(
     }
     v.push([x0, top]);
     v
+}
+
+/// The dishes' circles (centre height `centre_y`), in the order [`dished_ground`] lists
+/// their chords: the right dish's from edge 3, then, past the flat between them, the
+/// left one's.
+fn dish_arcs(centre_y: f64, radius: f64, centres: [f64; 2]) -> Vec<ArcDef> {
+    let right = [3, 2 + DISH_FACETS];
+    let left = [right[1] + 2, right[1] + 1 + DISH_FACETS];
+    [(centres[1], right), (centres[0], left)]
+        .into_iter()
+        .map(|(x, edges)| ArcDef {
+            center: [x, centre_y],
+            radius,
+            edges,
+        })
+        .collect()
 }
 
 /// The base slab `[x0, y0, x1, y1]` with a pointed foot under each x of `centres`, its

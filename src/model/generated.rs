@@ -116,6 +116,7 @@ fn ground_block(half_length: f64) -> BlockDef {
         vertices: rectangle(-half_length, -1.0, half_length, 0.0),
         material: concrete(2000.0),
         rigid: false,
+        arcs: Vec::new(),
     }
 }
 
@@ -147,6 +148,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
             vertices: rectangle(-12.3, 0.0, 12.3, t),
             material: slab,
             rigid: false,
+            arcs: Vec::new(),
         },
     ];
     let mut connections = Vec::new();
@@ -164,6 +166,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
             vertices: rectangle(-12.3, k as f64 * h, 12.3, k as f64 * h + t),
             material: slab,
             rigid: false,
+            arcs: Vec::new(),
         });
         for (side, x0, x1) in [("left", -12.2, -11.8), ("right", 11.8, 12.2)] {
             let name = format!("column-{k}-{side}");
@@ -173,6 +176,7 @@ pub fn frame(storeys: usize) -> Result<Scene> {
                 vertices: rectangle(x0, y0 + 0.4, x1, k as f64 * h - 0.1),
                 material: column,
                 rigid: false,
+                arcs: Vec::new(),
             });
             connections.extend(connection(&below, &name, x0, x1, y0 + t, y0 + 0.4));
             connections.extend(connection(
@@ -274,6 +278,7 @@ pub fn wall(n: usize) -> Result<Scene> {
             vertices: rectangle(-0.1, 0.0, width + 0.1, 0.3),
             material: concrete(2400.0),
             rigid: false,
+            arcs: Vec::new(),
         },
     ];
     let joint = |a: &str, b: &str| ContactDef {
@@ -324,6 +329,7 @@ pub fn wall(n: usize) -> Result<Scene> {
                 vertices: rectangle(x0, y0, x1, y0 + h),
                 material: masonry,
                 rigid: false,
+                arcs: Vec::new(),
             });
             if let Some((left, _, _)) = this.last() {
                 contacts.push(joint(left, &name));

@@ -21,7 +21,7 @@ use super::friction::Friction;
 use super::geometry::moments;
 use super::material::Material;
 use super::scene::{
-    BlockDef, ContactDef, ExcitationDef, GroundDef, GroundKind, Scene, SlidingBlockRoles,
+    ArcDef, BlockDef, ContactDef, ExcitationDef, GroundDef, GroundKind, Scene, SlidingBlockRoles,
 };
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::{Error, Result};
@@ -89,6 +89,7 @@ pub fn friction_pendulum(radius: f64) -> Result<Scene> {
                     plane: Default::default(),
                 },
                 rigid: false,
+                arcs: vec![dish_arc(dish_radius)],
             },
             BlockDef {
                 name: "slider".into(),
@@ -100,6 +101,7 @@ pub fn friction_pendulum(radius: f64) -> Result<Scene> {
                     plane: Default::default(),
                 },
                 rigid: true,
+                arcs: Vec::new(),
             },
         ],
         ground: GroundDef {
@@ -199,6 +201,15 @@ fn slider_vertices(rd: f64) -> Vec<[f64; 2]> {
     v.push([w, SLIDER_THICKNESS]);
     v.push([-w, SLIDER_THICKNESS]);
     v
+}
+
+/// The dish's circle: its chords are edges 3 to 2 + [`DISH_FACETS`] of [`dish_vertices`].
+fn dish_arc(rd: f64) -> ArcDef {
+    ArcDef {
+        center: [0.0, rd],
+        radius: rd,
+        edges: [3, 2 + DISH_FACETS],
+    }
 }
 
 /// The dish: a 1 m deep ground block whose top is the circle of radius `rd` between the

@@ -105,6 +105,24 @@ pub struct BlockDef {
     /// mass-spring model has rigid masses). Default: deformable.
     #[serde(default)]
     pub rigid: bool,
+    /// Runs of edges that are chords of a circle, concave as seen from outside the block
+    /// (a dish): contacts on them see the circle, not the facets. Default: none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub arcs: Vec<ArcDef>,
+}
+
+/// A run of a block's edges that are chords of one circle (`[[block.arcs]]` in a scene
+/// file): a dish, concave as seen from outside the block.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcDef {
+    /// The circle's centre, m (on the free side of the edges).
+    pub center: Point,
+    /// The circle's radius, m.
+    pub radius: f64,
+    /// First and last edge of the run, inclusive, counted from 0 (edge k runs from the
+    /// block's vertex k to vertex k + 1 of its `vertices` list).
+    pub edges: [usize; 2],
 }
 
 /// How the ground block moves.

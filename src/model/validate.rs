@@ -8,7 +8,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::geometry::{self, Point};
-use super::scene::{ExcitationDef, GroundKind, Scene};
+use super::scene::{ArcDef, ExcitationDef, GroundKind, Scene};
 use crate::limits::{
     FREQUENCY_RANGE_HZ, MAX_ACCEL_G, MAX_BLOCKS, MAX_COORDINATE_M, MAX_ELEMENTS, MAX_FORCE_N,
     MAX_GRAVITY, MAX_POLYGON_VERTICES, MAX_SCENE_VERTICES, MAX_SPAN_RATIO, MIN_AMPLITUDE_G,
@@ -372,11 +372,71 @@ fn check_blocks(scene: &Scene) -> std::result::Result<HashMap<&str, usize>, Issu
         geometry::moments(&b.vertices, &b.name)
             .and_then(|_| geometry::check_simple(&b.vertices, &b.name))
             .map_err(|e| Issue::from_error(at("vertices"), "", e))?;
+        for (k, arc) in b.arcs.iter().enumerate() {
+            let field = format!("block '{}' arc {}", b.name, k + 1);
+            check_arc(&b.vertices, arc).map_err(|why| Issue::new(at("arcs"), field, why))?;
+        }
+        if let Some(edge) = (0..n).find(|&e| b.arcs.iter().filter(|a| holds(a, e)).count() > 1) {
+            return Err(Issue::new(
+                at("arcs"),
+                format!("block '{}' arcs", b.name),
+                format!("edge {edge} is in two arcs; a chord belongs to one circle"),
+            ));
+        }
         b.material
             .validate(&format!("block '{}' material", b.name))
             .map_err(|e| Issue::from_error(at("material"), "", e))?;
     }
     Ok(names)
+}
+
+/// Whether edge `e` is one of the arc's chords.
+fn holds(arc: &ArcDef, e: usize) -> bool {
+    (arc.edges[0]..=arc.edges[1]).contains(&e)
+}
+
+/// An arc's edges must exist, their vertices lie on its circle, and the circle's centre be
+/// on their free side (a dish: the contact law of a convex arc is not written).
+fn check_arc(vertices: &[Point], arc: &ArcDef) -> std::result::Result<(), String> {
+    let n = vertices.len();
+    let [first, last] = arc.edges;
+    let finite = arc.center.iter().all(|c| c.is_finite());
+    if !(finite && arc.radius.is_finite() && arc.radius > 0.0) {
+        return Err(format!(
+            "needs a finite centre and a positive radius, got centre ({}, {}), radius {}",
+            arc.center[0], arc.center[1], arc.radius
+        ));
+    }
+    if first > last || last >= n {
+        return Err(format!(
+            "edges [{first}, {last}] are not a run of this polygon's edges 0 to {}",
+            n - 1
+        ));
+    }
+    let tolerance = 1e-6 * arc.radius;
+    for k in first..=last + 1 {
+        let p = vertices[k % n];
+        let off = geometry::sub(p, arc.center);
+        let off = off[0].hypot(off[1]) - arc.radius;
+        if off.abs() > tolerance {
+            return Err(format!(
+                "vertex {k} ({}, {}) is {off:.3e} m off the circle of radius {} about ({}, {});                  an arc's edges must be chords of its circle (to 1e-6 of the radius)",
+                p[0], p[1], arc.radius, arc.center[0], arc.center[1]
+            ));
+        }
+    }
+    for k in first..=last {
+        let (a, b) = (vertices[k], vertices[(k + 1) % n]);
+        let edge = geometry::sub(b, a);
+        let to_centre = geometry::sub(arc.center, a);
+        // Counter-clockwise polygon: the outside is to the right of an edge.
+        if geometry::cross(edge, to_centre) >= 0.0 {
+            return Err(format!(
+                "the circle's centre is inside the block from edge {k}: an arc must be a                  dish (its centre on the free side of every chord)"
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn check_ground(scene: &Scene) -> Check {

@@ -28,6 +28,7 @@ use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
 use super::judge::{ContactState, JudgeInput, judge};
 use super::linear::{BlockPattern, LinearSolver, SolveError, TINY_LIMIT};
 use super::params::{AlphaCoefficients, SolverParams};
+use super::surface;
 use crate::ground_motion::GroundMotion;
 use crate::model::friction::FrictionLaw;
 use crate::model::geometry::{self, Point};
@@ -294,6 +295,15 @@ impl Dda {
             };
             let mut block = Block::new(&b.name, b.vertices.clone(), b.material, role)?;
             block.rigid = b.rigid;
+            block.arcs = b
+                .arcs
+                .iter()
+                .map(|a| crate::dda::surface::CircularArc {
+                    center: a.center,
+                    radius: a.radius,
+                    edges: a.edges,
+                })
+                .collect();
             blocks.push(block);
         }
         let structure: Vec<Point> = blocks
@@ -526,7 +536,7 @@ impl Dda {
     /// finds, and a sliding frame's normal forces change by more than that tolerance
     /// (1e-4) in most steps. The prediction is O(Δt²) close and saves the extra pass
     /// (three-storey frame on El Centro: 1.40 passes per step before, 1.02 with it).
-    fn predict_friction_normals(&mut self, dt: f64) {
+    pub(super) fn predict_friction_normals(&mut self, dt: f64) {
         let previous_dt = self.last.dt;
         if previous_dt <= 0.0 {
             return;
@@ -546,6 +556,29 @@ impl Dda {
                     }
                 }
             }
+        }
+    }
+
+    /// Takes the frames of contacts on a curved surface (a dish) again, about the middle
+    /// of the slip this step of `dt` is expected to make (the slip speed at its start
+    /// times Δt): the vertex then moves on a chord square to the normal it is held along,
+    /// as it does on the circle (see [`crate::dda::surface`]). The prediction's error is
+    /// O(Δt²) of the slip, and so is the turn of the normal it leaves.
+    pub(super) fn follow_curvature(&mut self, dt: f64) {
+        let blocks = &self.blocks;
+        for c in &mut self.contacts {
+            if c.curvature == 0.0 {
+                continue;
+            }
+            let ahead = 0.5 * c.start_slip_velocity * dt;
+            let f = surface::frame_ahead(
+                &blocks[c.key.vertex_block],
+                &blocks[c.key.edge_block],
+                c.point,
+                c.key.edge,
+                ahead,
+            );
+            (c.gap_i, c.gap_j, c.slip_i, c.slip_j) = (f.gap_i, f.gap_j, f.slip_i, f.slip_j);
         }
     }
 

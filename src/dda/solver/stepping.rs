@@ -200,6 +200,7 @@ impl Dda {
             let known = self.known_increments();
             self.detect_contacts();
             self.predict_friction_normals(dt);
+            self.follow_curvature(dt);
             let outcome = self.iterate(mode, &known)?;
             // Land the step on a stick-slip (or impact) event: a transition assumed at the
             // step end is O(Δt) late; cutting the step to where it happened makes it O(Δt²).
@@ -326,7 +327,7 @@ impl Dda {
                             (false, _) => Restart::None,
                         };
                         // Grow back towards the nominal step after a cut.
-                        self.dt_current = (self.dt_current * 1.5).min(self.params.dt);
+                        self.dt_current = self.grown_step();
                         return Ok(Some(report));
                     }
                     self.counters.cut_reasons.too_far += 1;
@@ -341,16 +342,45 @@ impl Dda {
             self.counters.cuts += 1;
             self.dt_current *= self.params.cut_factor;
             if self.dt_current < dt_min {
+                let cause = self.rim_reached().unwrap_or_else(|| {
+                    "the contact springs may be far too stiff or soft for this Δt, or blocks \
+                     interpenetrate"
+                        .into()
+                });
                 return Err(Error::Solver {
                     time: self.time,
-                    reason: format!(
-                        "{reason}, even with Δt cut to {:.3e} s; the contact springs may be far too \
-                         stiff or soft for this Δt, or blocks interpenetrate",
-                        dt
-                    ),
+                    reason: format!("{reason}, even with Δt cut to {dt:.3e} s; {cause}"),
                 });
             }
         }
+    }
+
+    /// Why a step may fail that the solver cannot help: a vertex at the end of a dish's
+    /// curved surface (within 1 % of its radius of the rim) is being carried out of it.
+    fn rim_reached(&self) -> Option<String> {
+        self.contacts.iter().find_map(|c| {
+            let dish = &self.blocks[c.key.edge_block];
+            let p = c.point;
+            // On the arc's last facets or already past its end, on the rim's far side.
+            let near = dish.arcs.iter().any(|arc| {
+                let ends = [
+                    dish.vertices[arc.edges[0]],
+                    dish.vertices[(arc.edges[1] + 1) % dish.vertices.len()],
+                ];
+                ends.iter().any(|e| {
+                    let d = geometry::sub(p, *e);
+                    d[0].hypot(d[1]) < 0.01 * arc.radius
+                })
+            });
+            near.then(|| {
+                format!(
+                    "vertex {} of block '{}' has reached the rim of the dish in block '{}' at \
+                     ({:.3}, {:.3}) m: the motion carries it out of the dish (a larger radius or \
+                     a weaker record keeps it in)",
+                    c.key.vertex, self.blocks[c.key.vertex_block].name, dish.name, p[0], p[1]
+                )
+            })
+        })
     }
 
     /// Accepts a converged step: integrator update, energy bookkeeping, geometry.
@@ -617,17 +647,29 @@ impl Dda {
             // step's own, which the caller still reads, are set aside meanwhile).
             std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
             self.detect_contacts();
+            // Along the directions the next step will hold them along, so that its forces
+            // at both ends act along the same normal (square to a dish contact's chord).
+            self.follow_curvature(self.grown_step());
             self.add_contact_forces(&mut out);
             std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
         }
         out
     }
 
+    /// The nominal size of the step after an accepted one: back towards Δt after a cut.
+    fn grown_step(&self) -> f64 {
+        (self.dt_current * 1.5).min(self.params.dt)
+    }
+
     /// Adds the generalised forces the closed contacts exert on the blocks: the normal
-    /// and shear forces of their memory along the gradients of `self.contacts`.
+    /// and shear forces of their memory along the gradients of `self.contacts`. (A vertex
+    /// that has just moved on to the next edge of a polyline — a dish's next facet —
+    /// carries the old edge's memory: missing its force here once made the dish's slider
+    /// lose its weight for a step at every facet it crossed.)
     fn add_contact_forces(&self, out: &mut [Vec6]) {
         for c in &self.contacts {
-            let Some(m) = self.memory.get(&c.key) else {
+            let edges = self.blocks[c.key.edge_block].vertices.len();
+            let Some(m) = super::super::contact::remembered(&self.memory, c.key, edges) else {
                 continue;
             };
             if !m.state.is_closed() {
