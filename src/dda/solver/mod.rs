@@ -563,11 +563,14 @@ impl Dda {
     /// of the slip this step of `dt` is expected to make (the slip speed at its start
     /// times Δt): the vertex then moves on a chord square to the normal it is held along,
     /// as it does on the circle (see [`crate::dda::surface`]). The prediction's error is
-    /// O(Δt²) of the slip, and so is the turn of the normal it leaves.
+    /// O(Δt²) of the slip, and so is the turn of the normal it leaves. Only a contact that
+    /// starts the step sliding is expected to slip: a stuck one's slip speed is round-off,
+    /// and turning its frame by it fed back into it (a bonded slider's frame turned by
+    /// radians within 50 steps, through the two corners' self-equilibrated multipliers).
     pub(super) fn follow_curvature(&mut self, dt: f64) {
         let blocks = &self.blocks;
         for c in &mut self.contacts {
-            if c.curvature == 0.0 {
+            if c.curvature == 0.0 || !matches!(c.start_state, ContactState::Sliding { .. }) {
                 continue;
             }
             let ahead = 0.5 * c.start_slip_velocity * dt;
