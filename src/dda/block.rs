@@ -3,8 +3,7 @@
 use crate::Result;
 use crate::model::geometry::{self, Moments, Point};
 use crate::model::material::Material;
-
-use super::surface::CircularArc;
+use crate::model::scene::ArcDef;
 
 /// Six block unknowns `(u0, v0, r0, εx, εy, γxy)` or a 6-vector of generalised forces.
 pub type Vec6 = [f64; 6];
@@ -251,8 +250,9 @@ pub struct Block {
     /// its stresses on the strain increments (see [`Block::strain_energy`]).
     pub elastic_energy: f64,
     /// Runs of edges that are chords of a circle (a dish), which contacts see as the
-    /// circle itself (see [`crate::dda::surface`]).
-    pub arcs: Vec<CircularArc>,
+    /// circle itself (see [`crate::dda::surface`]); each centre is a material point of
+    /// the block, moved with it.
+    pub arcs: Vec<ArcDef>,
 }
 
 impl Block {
@@ -341,6 +341,11 @@ impl Block {
             plane: Default::default(),
         };
         Self::new("b", vertices, material, BlockRole::Free).expect("a valid test polygon")
+    }
+
+    /// The arc whose chord edge `k` is, if any.
+    pub fn arc_of(&self, k: usize) -> Option<&ArcDef> {
+        self.arcs.iter().find(|a| a.holds_edge(k))
     }
 
     /// Moves the block by the step's unknowns `d`: vertices, stress, strain, moments and

@@ -246,11 +246,7 @@ pub fn detect(
 /// step crosses: a slider at 1.4 m/s crosses more than one 1.4 mm facet per step), else
 /// `k` itself.
 fn surface_edge(block: &Block, k: usize) -> usize {
-    block
-        .arcs
-        .iter()
-        .find(|a| a.holds_edge(k))
-        .map_or(k, |a| a.edges[0])
+    block.arc_of(k).map_or(k, |a| a.edges[0])
 }
 
 /// What the contact `key` remembers from the last step: its own memory, or, for a vertex
@@ -306,7 +302,7 @@ fn detect_one_way(
             continue;
         }
         // Best candidate edge: smallest |gap|, preferring the edge this vertex touched last.
-        let mut best: Option<(usize, f64, bool)> = None;
+        let mut best: Option<(ContactKey, f64, bool)> = None;
         for ek in 0..ne {
             let p2 = eblock.vertices[ek];
             let EdgeFrame {
@@ -349,16 +345,10 @@ fn detect_one_way(
                 Some((_, g, k)) => (known && !k) || (known == k && gap.abs() < g.abs()),
             };
             if better {
-                best = Some((ek, gap, known));
+                best = Some((key, gap, known));
             }
         }
-        let Some((ek, _, _)) = best else { continue };
-        let key = ContactKey {
-            vertex_block: vb,
-            vertex: vi,
-            edge_block: eb,
-            edge: surface_edge(eblock, ek),
-        };
+        let Some((key, _, _)) = best else { continue };
         let mem = remembered(memory, key, ne);
         out.push(linearise(vblock, eblock, key, pair, props, mem));
     }

@@ -18,25 +18,7 @@
 
 use super::block::{Block, EdgeFrame, Vec6, t_transpose_times};
 use crate::model::geometry::{Point, cross, dot, sub};
-
-/// A run of a block's edges that are chords of one circle, concave as seen from outside
-/// the block (the circle's centre on the free side): a dish.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CircularArc {
-    /// The circle's centre, m: a material point of the block, moved with it.
-    pub center: Point,
-    /// The circle's radius, m.
-    pub radius: f64,
-    /// First and last edge of the run (inclusive; edge k runs from vertex k to k + 1).
-    pub edges: [usize; 2],
-}
-
-impl CircularArc {
-    /// Whether edge `k` is one of the arc's chords.
-    pub fn holds_edge(&self, k: usize) -> bool {
-        (self.edges[0]..=self.edges[1]).contains(&k)
-    }
-}
+use crate::model::scene::ArcDef;
 
 /// A contact's linearised geometry at the step start.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,7 +56,7 @@ pub fn frame_ahead(
     edge: usize,
     ahead: f64,
 ) -> SurfaceFrame {
-    match eblock.arcs.iter().find(|a| a.holds_edge(edge)) {
+    match eblock.arc_of(edge) {
         Some(arc) => on_circle(vblock, eblock, p1, arc, ahead),
         None => on_edge(vblock, eblock, p1, edge),
     }
@@ -120,13 +102,7 @@ fn on_edge(vblock: &Block, eblock: &Block, p1: Point, edge: usize) -> SurfaceFra
 /// and the gap `R − |P1 − C|`. Its first-order change is n̂·(ΔP1 − ΔQ), ΔQ the motion of
 /// the dish's material point Q (a rigid turn about C does not move the circle). With
 /// `ahead` ≠ 0, Q, n̂ and t̂ are those of the circle's point that far along t̂.
-fn on_circle(
-    vblock: &Block,
-    eblock: &Block,
-    p1: Point,
-    arc: &CircularArc,
-    ahead: f64,
-) -> SurfaceFrame {
+fn on_circle(vblock: &Block, eblock: &Block, p1: Point, arc: &ArcDef, ahead: f64) -> SurfaceFrame {
     let u = sub(p1, arc.center);
     let r = u[0].hypot(u[1]);
     let (gap0, under) = (arc.radius - r, [u[0] / r, u[1] / r]);
@@ -183,7 +159,7 @@ mod tests {
         }));
         v.push([-2.0, rim[1]]);
         let mut b = block(v);
-        b.arcs.push(CircularArc {
+        b.arcs.push(ArcDef {
             center: [0.0, 2.0],
             radius: r,
             edges: [3, 3 + n - 1],

@@ -125,6 +125,13 @@ pub struct ArcDef {
     pub edges: [usize; 2],
 }
 
+impl ArcDef {
+    /// Whether edge `k` is one of the arc's chords.
+    pub fn holds_edge(&self, k: usize) -> bool {
+        (self.edges[0]..=self.edges[1]).contains(&k)
+    }
+}
+
 /// How the ground block moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]

@@ -376,7 +376,8 @@ fn check_blocks(scene: &Scene) -> std::result::Result<HashMap<&str, usize>, Issu
             let field = format!("block '{}' arc {}", b.name, k + 1);
             check_arc(&b.vertices, arc).map_err(|why| Issue::new(at("arcs"), field, why))?;
         }
-        if let Some(edge) = (0..n).find(|&e| b.arcs.iter().filter(|a| holds(a, e)).count() > 1) {
+        if let Some(edge) = (0..n).find(|&e| b.arcs.iter().filter(|a| a.holds_edge(e)).count() > 1)
+        {
             return Err(Issue::new(
                 at("arcs"),
                 format!("block '{}' arcs", b.name),
@@ -388,11 +389,6 @@ fn check_blocks(scene: &Scene) -> std::result::Result<HashMap<&str, usize>, Issu
             .map_err(|e| Issue::from_error(at("material"), "", e))?;
     }
     Ok(names)
-}
-
-/// Whether edge `e` is one of the arc's chords.
-fn holds(arc: &ArcDef, e: usize) -> bool {
-    (arc.edges[0]..=arc.edges[1]).contains(&e)
 }
 
 /// An arc's edges must exist, their vertices lie on its circle, and the circle's centre be

@@ -4,8 +4,8 @@
 //! Every damping force is c·v at the step's end (where the integrator balances every
 //! force), with the end velocity of a free block from the Newmark update,
 //! v₁ = γ/(βΔt)·D + w (linear in the increment D), so a dashpot adds c·γ/(βΔt) to the
-//! stiffness and its predictor part to the right-hand side. The ledger books, like every other force, the average of the force at
-//! the step's two ends times the increment.
+//! stiffness and its predictor part to the right-hand side. The ledger books, like every
+//! other force, the average of the force at the step's two ends times the increment.
 
 use super::*;
 use crate::dda::rayleigh::RayleighDamping;

@@ -295,15 +295,7 @@ impl Dda {
             };
             let mut block = Block::new(&b.name, b.vertices.clone(), b.material, role)?;
             block.rigid = b.rigid;
-            block.arcs = b
-                .arcs
-                .iter()
-                .map(|a| crate::dda::surface::CircularArc {
-                    center: a.center,
-                    radius: a.radius,
-                    edges: a.edges,
-                })
-                .collect();
+            block.arcs = b.arcs.clone();
             blocks.push(block);
         }
         let structure: Vec<Point> = blocks
@@ -536,7 +528,7 @@ impl Dda {
     /// finds, and a sliding frame's normal forces change by more than that tolerance
     /// (1e-4) in most steps. The prediction is O(Δt²) close and saves the extra pass
     /// (three-storey frame on El Centro: 1.40 passes per step before, 1.02 with it).
-    pub(super) fn predict_friction_normals(&mut self, dt: f64) {
+    fn predict_friction_normals(&mut self, dt: f64) {
         let previous_dt = self.last.dt;
         if previous_dt <= 0.0 {
             return;
@@ -567,7 +559,7 @@ impl Dda {
     /// starts the step sliding is expected to slip: a stuck one's slip speed is round-off,
     /// and turning its frame by it fed back into it (a bonded slider's frame turned by
     /// radians within 50 steps, through the two corners' self-equilibrated multipliers).
-    pub(super) fn follow_curvature(&mut self, dt: f64) {
+    fn follow_curvature(&mut self, dt: f64) {
         let blocks = &self.blocks;
         for c in &mut self.contacts {
             if c.curvature == 0.0 || !matches!(c.start_state, ContactState::Sliding { .. }) {

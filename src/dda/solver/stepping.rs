@@ -669,7 +669,7 @@ impl Dda {
     fn add_contact_forces(&self, out: &mut [Vec6]) {
         for c in &self.contacts {
             let edges = self.blocks[c.key.edge_block].vertices.len();
-            let Some(m) = super::super::contact::remembered(&self.memory, c.key, edges) else {
+            let Some(m) = contact::remembered(&self.memory, c.key, edges) else {
                 continue;
             };
             if !m.state.is_closed() {
