@@ -165,8 +165,8 @@ struct Stepping {
     /// Time step of the DDA model, s (default 1e-3).
     #[arg(long, allow_hyphen_values = true)]
     dt: Option<f64>,
-    /// DDA integrator: classic | trapezoidal | hht[:α] | generalized-alpha[:ρ∞] (default
-    /// generalized-alpha:0).
+    /// DDA integrator: classic | trapezoidal | hht[:α] | generalized-alpha[:ρ∞] (default:
+    /// the scene's — generalized-alpha:0.5 for two-block, generalized-alpha:0 otherwise).
     #[arg(long)]
     integrator: Option<String>,
     /// Run even if a run is larger than the limit of 1e8 steps.

@@ -17,7 +17,7 @@ fn sweep(
     ratios: Vec<f64>,
     duration: f64,
 ) -> slidebase::post::sweep::ErrorTable {
-    sweep_with(alphas, frictions, ratios, duration, Integrator::default()).0
+    sweep_with(alphas, frictions, ratios, duration, None).0
 }
 
 /// The sweep's error table and the DDA rows' energy residuals.
@@ -26,7 +26,7 @@ fn sweep_with(
     frictions: Vec<f64>,
     ratios: Vec<f64>,
     duration: f64,
-    integrator: Integrator,
+    integrator: Option<Integrator>,
 ) -> (slidebase::post::sweep::ErrorTable, Vec<f64>) {
     let req = SweepRequest {
         alphas,
@@ -36,7 +36,7 @@ fn sweep_with(
         damping: None,
         duration: Some(duration),
         dt: Some(1e-3),
-        integrator: Some(integrator),
+        integrator,
         confirm_large: false,
         models: vec![ModelKind::MassSpring, ModelKind::Dda],
         shard: None,
@@ -95,37 +95,32 @@ fn dda_matches_the_exact_model_on_representative_points() {
 ///
 /// - The trapezoidal rule (non-dissipative) meets all of them, and its energy balance
 ///   closes: residual median ≤ 1e-8, largest ≤ 1e-6 of the energy that passed through.
-/// - The default generalised-α (ρ∞ = 0) meets the medians and percentiles, and the largest
-///   error for u_r, a_base and a_roof. Its largest u_s error (6.2 % at (0.9, 0.05, 10),
-///   100 steps per period of the input, where the trapezoidal rule errs by 0.7 %) is not
-///   asserted: docs/validation.md reports it as a missed target.
+/// - So does the scene's default, generalised-α with ρ∞ = 0.5 (the two-block scene asks
+///   for it: rigid blocks, nothing to annihilate). The solver's default for deformable
+///   scenes, ρ∞ = 0, has a 5× larger error constant on the resolved motion: its largest
+///   slip error is 6.2 % at (0.9, 0.05, 10) — second order, 0.2 % at Δt = 0.25 ms — so
+///   the two-block scene does not use it; its energy is checked here, its errors are not.
 ///
 /// Slow (≈ 4 min in release): run with `cargo test --release -- --ignored`.
 #[test]
 #[ignore]
 fn full_paper_grid_meets_the_targets() {
-    for integrator in [
-        "trapezoidal",
-        "generalized-alpha:0",
-        "generalized-alpha:0.5",
-    ] {
+    for integrator in [None, Some("trapezoidal"), Some("generalized-alpha:0")] {
         let (t, residuals) = sweep_with(
             vec![0.1, 0.5, 0.9],
             vec![0.01, 0.05, 0.1, 0.25],
             paper_ratios(),
             100.0,
-            Integrator::parse(integrator).unwrap(),
+            integrator.map(|i| Integrator::parse(i).unwrap()),
         );
+        let integrator = integrator.unwrap_or("the scene's default");
         println!("{integrator}:\n{t}");
-        // ρ∞ = 0's largest slip error (6.2 % at Ω/ω = 10) is its truncation error on the
-        // ground's displacement, which the slip is a small difference from; see
-        // docs/validation.md. Every other member of the family meets all the targets.
+        // ρ∞ = 0's errors are reported (docs/validation.md), not asserted.
         let annihilating = integrator == "generalized-alpha:0";
-        for (k, m) in t.metrics.iter().enumerate() {
+        for m in t.metrics.iter().filter(|_| !annihilating) {
             assert_eq!(m.count, 300);
-            let max_checked = !(annihilating && k == 0);
             assert!(
-                m.median <= 1e-3 && m.p90 <= 5e-3 && (!max_checked || m.max <= 0.02),
+                m.median <= 1e-3 && m.p90 <= 5e-3 && m.max <= 0.02,
                 "{integrator}, {}: median {:.3} %, 90th {:.3} %, max {:.3} % at {:?}",
                 m.name,
                 100.0 * m.median,
@@ -134,15 +129,13 @@ fn full_paper_grid_meets_the_targets() {
                 m.worst
             );
         }
-        if !annihilating {
-            let mut r = residuals.clone();
-            r.sort_by(f64::total_cmp);
-            let (median, max) = (r[r.len() / 2], r[r.len() - 1]);
-            assert!(
-                median <= 1e-8 && max <= 1e-6,
-                "energy residual median {median:.1e}, max {max:.1e}"
-            );
-        }
+        let mut r = residuals.clone();
+        r.sort_by(f64::total_cmp);
+        let (median, max) = (r[r.len() / 2], r[r.len() - 1]);
+        assert!(
+            median <= 1e-8 && max <= 1e-6,
+            "{integrator}: energy residual median {median:.1e}, max {max:.1e}"
+        );
     }
 }
 

@@ -314,7 +314,7 @@ fn a_third_vertex_coordinate_is_an_error_with_its_line() {
     );
     assert_has(
         &scene_error(&text),
-        &["s.toml:32", "two coordinates", "got 3"],
+        &["s.toml:38", "two coordinates", "got 3"],
     );
 }
 
@@ -387,7 +387,7 @@ fn an_arc_that_is_not_its_blocks_edges_is_refused() {
     assert_has(
         &off,
         &[
-            "s.toml:28",
+            "s.toml:34",
             "arc 1",
             "off the circle",
             "chords of its circle",
@@ -809,17 +809,51 @@ fn friction_laws_in_a_scene_file_are_parsed_or_refused_with_their_line() {
     ));
     assert_has(
         &scene_error(&with("\"static-kinetic:0.4,0.6\"")),
-        &["s.toml:49", "must not exceed"],
+        &["s.toml:55", "must not exceed"],
     );
     assert_has(
         &scene_error(&with("\"stribeck:0.1\"")),
         &[
-            "s.toml:49",
+            "s.toml:55",
             "static-kinetic:MU_S,MU_K",
             "velocity:MU_SLOW,MU_FAST,RATE",
         ],
     );
     assert_has(&scene_error(&with("-0.5")), &["friction", "got -0.5"]);
+}
+
+/// A scene names the integrator its blocks need (the two-block scene: generalised-α
+/// ρ∞ = 0.5; scenes that name none: the solver's ρ∞ = 0); `--integrator` overrides it, and
+/// a scheme that does not exist is refused with its line and the accepted spellings.
+#[test]
+fn a_scene_names_its_integrator_and_the_command_line_overrides_it() {
+    use slidebase::dda::Integrator;
+    let integrator = |spec: RunSpec| spec.prepare().unwrap().integrator;
+    assert_eq!(
+        integrator(RunSpec::default()),
+        Integrator::GeneralizedAlpha { rho_inf: 0.5 }
+    );
+    assert_eq!(
+        integrator(RunSpec::scene("three-storey")),
+        Integrator::default()
+    );
+    assert_eq!(
+        integrator(RunSpec {
+            integrator: Some(Integrator::Trapezoidal),
+            ..RunSpec::default()
+        }),
+        Integrator::Trapezoidal
+    );
+    let text = TWO_BLOCK.replace(
+        "integrator = \"generalized-alpha:0.5\"",
+        "integrator = \"euler\"",
+    );
+    assert_has(
+        &scene_error(&text),
+        &["s.toml:27", "euler", "generalized-alpha[:rho_inf]"],
+    );
+    let text = TWO_BLOCK.replace("generalized-alpha:0.5", "generalized-alpha:2");
+    assert_has(&scene_error(&text), &["s.toml:27", "rho_inf in [0, 1]"]);
 }
 
 /// A two-block scene whose joint has a static-kinetic law keeps it in a DDA run (the

@@ -4,48 +4,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
 
-/// Time integration scheme. All are members of the generalised-α family
-/// (Chung & Hulbert 1993), which contains Newmark's family as αm = αf = 0, written as
-/// Arnold & Brüls (2007) do for constrained systems: the forces are balanced at the step's
-/// end, `M q̈(n+1) = f(t(n+1))`, and the scheme's acceleration variable follows
-/// `(1−αm) a(n+1) + αm a(n) = (1−αf) q̈(n+1) + αf q̈(n)`, with Newmark updates (β, γ) on
-/// `a` (see `dda::integrator`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
-pub enum Integrator {
-    /// Shi's original DDA: Newmark β = ½, γ = 1. First order, strongly dissipative at high
-    /// frequency and also (by O(ωΔt)) at the structure's own frequencies. The paper's scheme.
-    Classic,
-    /// Average acceleration (β = ¼, γ = ½): second order, no numerical dissipation at all:
-    /// stiff contact springs that ring keep ringing.
-    Trapezoidal,
-    /// Hilber–Hughes–Taylor α-method, α ∈ [0, ⅓]: second order with dissipation that grows
-    /// with frequency.
-    Hht {
-        /// α ∈ [0, 1/3]; 0 is the trapezoidal rule.
-        alpha: f64,
-    },
-    /// Generalised-α with spectral radius ρ∞ at infinite frequency: second order, optimal
-    /// high-frequency dissipation for a given low-frequency error. ρ∞ = 1 is trapezoidal,
-    /// ρ∞ = 0 annihilates unresolved modes in one step.
-    GeneralizedAlpha {
-        /// Spectral radius at infinite frequency, in [0, 1].
-        rho_inf: f64,
-    },
-}
-
-impl Default for Integrator {
-    fn default() -> Self {
-        // Second-order accuracy on the structure (errors ~(ωΔt)² ≈ 4e-5 at 1 Hz, Δt = 1 ms)
-        // while the unresolved penalty-spring modes (kHz) are annihilated in one step
-        // (ρ∞ = 0), so the penalty springs do not ring when a sliding joint re-sticks — the
-        // ringing that otherwise inflates peak base accelerations by 5–70 %. Measured on the
-        // two-block model (α = 0.5, ρ = 0.1, Ω = ω): ρ∞ = 0 gives a_base within 0.2 % of the
-        // exact value, ρ∞ = 0.5 within 5 %, ρ∞ = 0.8 within 10 %, trapezoidal within 5 %.
-        Integrator::GeneralizedAlpha { rho_inf: 0.0 }
-    }
-}
-
 /// The four coefficients of the generalised-α family.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlphaCoefficients {
@@ -60,25 +18,6 @@ pub struct AlphaCoefficients {
 }
 
 impl Integrator {
-    /// Validates the scheme's parameter.
-    pub fn validate(&self) -> Result<()> {
-        match *self {
-            Integrator::Hht { alpha } if !(0.0..=1.0 / 3.0).contains(&alpha) => {
-                Err(Error::invalid(
-                    "integrator alpha",
-                    format!("HHT needs alpha in [0, 1/3], got {alpha}"),
-                ))
-            }
-            Integrator::GeneralizedAlpha { rho_inf } if !(0.0..=1.0).contains(&rho_inf) => {
-                Err(Error::invalid(
-                    "integrator rho_inf",
-                    format!("generalised-alpha needs rho_inf in [0, 1], got {rho_inf}"),
-                ))
-            }
-            _ => Ok(()),
-        }
-    }
-
     /// The scheme's coefficients.
     pub fn coefficients(&self) -> AlphaCoefficients {
         match *self {
@@ -113,53 +52,10 @@ impl Integrator {
             }
         }
     }
-
-    /// Parses the command-line spelling: `classic`, `trapezoidal`, `hht[:α]`,
-    /// `generalized-alpha[:ρ∞]` (alias `gen-alpha`).
-    pub fn parse(text: &str) -> Result<Self> {
-        let (name, arg) = match text.split_once(':') {
-            Some((n, a)) => (n, Some(a)),
-            None => (text, None),
-        };
-        let value = |default: f64| -> Result<f64> {
-            match arg {
-                None => Ok(default),
-                Some(a) => a
-                    .parse::<f64>()
-                    .map_err(|_| Error::invalid("integrator", format!("'{a}' is not a number"))),
-            }
-        };
-        let scheme = match name {
-            "classic" => Integrator::Classic,
-            "trapezoidal" => Integrator::Trapezoidal,
-            "hht" => Integrator::Hht { alpha: value(0.1)? },
-            "generalized-alpha" | "gen-alpha" => Integrator::GeneralizedAlpha {
-                rho_inf: value(0.0)?,
-            },
-            _ => {
-                return Err(Error::Unknown {
-                    kind: "integrator",
-                    name: text.to_string(),
-                    known: "classic, trapezoidal, hht[:alpha], generalized-alpha[:rho_inf]".into(),
-                });
-            }
-        };
-        scheme.validate()?;
-        Ok(scheme)
-    }
-
-    /// The command-line spelling of this scheme.
-    pub fn label(&self) -> String {
-        match self {
-            Integrator::Classic => "classic".into(),
-            Integrator::Trapezoidal => "trapezoidal".into(),
-            Integrator::Hht { alpha } => format!("hht:{alpha}"),
-            Integrator::GeneralizedAlpha { rho_inf } => format!("generalized-alpha:{rho_inf}"),
-        }
-    }
 }
 
 pub use crate::model::enforcement::ContactEnforcement;
+pub use crate::model::integration::Integrator;
 
 /// Everything that controls the DDA solver (not the physics of the scene).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -209,13 +105,15 @@ pub struct SolverParams {
 }
 
 impl SolverParams {
-    /// The defaults, with the contact enforcement the scene asks for (if it does).
+    /// The defaults, with the contact enforcement and the integrator the scene asks for
+    /// (if it does).
     pub fn for_scene(scene: &crate::model::Scene) -> Self {
         let defaults = Self::default();
         Self {
             contact_enforcement: scene
                 .contact_enforcement
                 .unwrap_or(defaults.contact_enforcement),
+            integrator: scene.integrator.unwrap_or(defaults.integrator),
             ..defaults
         }
     }
@@ -293,16 +191,5 @@ mod tests {
             let c = Integrator::GeneralizedAlpha { rho_inf: rho }.coefficients();
             assert!((c.gamma - (0.5 - c.alpha_m + c.alpha_f)).abs() < 1e-15);
         }
-    }
-
-    #[test]
-    fn parse_names() {
-        assert_eq!(Integrator::parse("classic").unwrap(), Integrator::Classic);
-        assert_eq!(
-            Integrator::parse("hht:0.2").unwrap(),
-            Integrator::Hht { alpha: 0.2 }
-        );
-        assert!(Integrator::parse("hht:0.9").is_err());
-        assert!(Integrator::parse("euler").is_err());
     }
 }

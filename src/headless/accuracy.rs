@@ -149,6 +149,11 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(0.01)
 }
 
+/// The integrator the two-block scene asks for (its runs' default).
+fn two_block_integrator() -> Result<Integrator> {
+    Ok(crate::setup::RunSpec::default().prepare()?.integrator)
+}
+
 /// The DDA two-block run of a case with these numerical settings, and the errors against
 /// the exact solution.
 #[allow(clippy::too_many_arguments)]
@@ -388,7 +393,8 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
             );
         }
     }
-    // 3. Penalty stiffness (penalty contacts, Δt = 1 ms, default integrator).
+    // 3. Penalty stiffness (penalty contacts, Δt = 1 ms, the two-block scene's integrator).
+    let scene_default = two_block_integrator()?;
     let reference = exact_reference(resonant, duration, false)?;
     for &p in &penalties {
         bump(
@@ -397,7 +403,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
                 "penalty",
                 resonant,
                 duration,
-                Integrator::default(),
+                scene_default,
                 1e-3,
                 Some(p),
                 None,
@@ -414,7 +420,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
             "ground",
             resonant,
             duration,
-            Integrator::default(),
+            scene_default,
             1e-3,
             None,
             None,
@@ -430,7 +436,7 @@ pub fn run_accuracy(quick: bool, tick: &dyn Fn(usize, usize)) -> Result<Vec<Accu
                 "ground",
                 resonant,
                 duration,
-                Integrator::default(),
+                scene_default,
                 1e-3,
                 None,
                 Some((GroundKind::LargeMass, r)),
@@ -924,13 +930,14 @@ fn findings(rows: &[AccuracyRow], labels: &[String]) -> Vec<String> {
         .min_by(|a, b| a.2.total_cmp(&b.2));
     match cheapest {
         Some((label, dt, wall)) => {
-            let default = crate::dda::Integrator::default().label();
+            let default = two_block_integrator().map_or(String::new(), |i| i.label());
             let note = if *label == default && (dt - 1e-3).abs() < 1e-12 {
-                "— the solver's default".to_string()
+                "— the two-block scene's default".to_string()
             } else {
                 format!(
-                    "(the solver's default is {default} at Δt = 1 ms: it keeps a margin for \
-                     records and scenes with faster content than these harmonic cases)"
+                    "(the two-block scene's default is {default} at Δt = 1 ms: it keeps a \
+                     margin for records and scenes with faster content than these harmonic \
+                     cases)"
                 )
             };
             out.push(format!(

@@ -241,6 +241,7 @@ fn building(
         sliding_block: None,
         vertical_excitation: None,
         contact_enforcement: None,
+        integrator: None,
         structure: Some(StructureRoles {
             base: "base-slab".into(),
             floors,

@@ -5,6 +5,7 @@ pub mod enforcement;
 pub mod friction;
 pub mod generated;
 pub mod geometry;
+pub mod integration;
 pub mod material;
 pub mod pendulum;
 pub mod presets;

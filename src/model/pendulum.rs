@@ -128,6 +128,7 @@ pub fn friction_pendulum(radius: f64) -> Result<Scene> {
         },
         vertical_excitation: None,
         contact_enforcement: None,
+        integrator: None,
         two_block: None,
         structure: None,
         sliding_block: Some(SlidingBlockRoles {

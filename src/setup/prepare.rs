@@ -96,7 +96,7 @@ impl RunSpec {
         let scene = self.scene.load()?;
         check::check_applicable(self, &scene)?;
         let dt = self.dt.unwrap_or(defaults::DT);
-        let integrator = self.integrator.unwrap_or_default();
+        let integrator = self.integrator.or(scene.integrator).unwrap_or_default();
         let mut setup = if let Some(roles) = scene.two_block.clone() {
             self.two_block(scene, roles)?
         } else if let Some(roles) = scene.structure.clone() {

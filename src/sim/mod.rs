@@ -52,8 +52,8 @@ pub struct SimConfig {
     pub alpha: Option<f64>,
     /// Ground motion.
     pub excitation: Excitation,
-    /// Integrator.
-    pub integrator: Integrator,
+    /// Integrator (None: the scene's choice, see [`crate::model::Scene::integrator`]).
+    pub integrator: Option<Integrator>,
     /// Time step, s.
     pub dt: f64,
     /// Also run the fixed-base comparison.
@@ -87,7 +87,7 @@ impl Default for SimConfig {
             friction_law: None,
             alpha: None,
             excitation: Excitation::Scene,
-            integrator: Integrator::default(),
+            integrator: None,
             dt: crate::setup::defaults::DT,
             compare_fixed: true,
             compare_friction: Vec::new(),
@@ -223,7 +223,7 @@ impl SimConfig {
             friction_law: self.friction_law,
             duration: self.duration,
             dt: Some(self.dt),
-            integrator: Some(self.integrator),
+            integrator: self.integrator,
             pga_g: self.pga_g,
             damping: self.damping,
             bearing: self.bearing,

@@ -388,31 +388,44 @@ impl AppState {
     }
 
     fn section_solver(&mut self, ui: &mut egui::Ui) {
+        let selected = self
+            .controls
+            .integrator
+            .map_or("the scene's choice".to_string(), |i| i.label());
         egui::ComboBox::from_id_salt("integrator")
-            .selected_text(self.controls.integrator.label())
+            .selected_text(selected)
             .width(COMBO_WIDTH)
             .truncate()
             .show_ui(ui, |ui| {
-                ui.selectable_value(
-                    &mut self.controls.integrator,
-                    Integrator::default(),
-                    "generalized-α (damps only numerical noise)",
-                );
-                ui.selectable_value(
-                    &mut self.controls.integrator,
-                    Integrator::Trapezoidal,
-                    "trapezoidal (no numerical damping)",
-                );
-                ui.selectable_value(
-                    &mut self.controls.integrator,
-                    Integrator::Classic,
-                    "classic DDA (the paper's; damps strongly)",
-                );
+                let choices = [
+                    (None, "the scene's choice (generalized-α)"),
+                    (
+                        Some(Integrator::default()),
+                        "generalized-α ρ∞ 0 (damps only numerical noise)",
+                    ),
+                    (
+                        Some(Integrator::GeneralizedAlpha { rho_inf: 0.5 }),
+                        "generalized-α ρ∞ 0.5 (rigid blocks)",
+                    ),
+                    (
+                        Some(Integrator::Trapezoidal),
+                        "trapezoidal (no numerical damping)",
+                    ),
+                    (
+                        Some(Integrator::Classic),
+                        "classic DDA (the paper's; damps strongly)",
+                    ),
+                ];
+                for (value, label) in choices {
+                    ui.selectable_value(&mut self.controls.integrator, value, label);
+                }
             })
             .response
             .on_hover_text(
-                "how the equations of motion are stepped in time; the default removes only \
-                 high-frequency numerical noise",
+                "how the equations of motion are stepped in time. The scene's choice is \
+                 generalized-α: ρ∞ 0 for deformable buildings (removes their unresolved \
+                 high-frequency modes in one step), ρ∞ 0.5 for the rigid two-block model \
+                 (more accurate at high excitation frequencies)",
             );
         ui.add(
             egui::Slider::new(&mut self.controls.dt, 1e-4..=1e-2)
@@ -583,7 +596,8 @@ impl AppState {
         if let Some(c) = &self.timeline.config {
             ui.label(format!(
                 "integrator {}, Δt {} s",
-                c.integrator.label(),
+                c.integrator
+                    .map_or("as the scene asks".to_string(), |i| i.label()),
                 crate::post::format_number(c.dt)
             ));
         }

@@ -126,8 +126,8 @@ pub struct Controls {
     pub friction: f64,
     /// Mass ratio α (two-block scene).
     pub alpha: f64,
-    /// Integrator.
-    pub integrator: Integrator,
+    /// Integrator (None: the scene's choice).
+    pub integrator: Option<Integrator>,
     /// Time step, s.
     pub dt: f64,
     /// What runs beside the model.
@@ -197,7 +197,7 @@ impl Default for Controls {
             pga_g: None,
             friction: 0.01,
             alpha: 0.5,
-            integrator: Integrator::default(),
+            integrator: None,
             dt: 1e-3,
             comparison: Comparison::FixedBase,
             damping: 0.0,
