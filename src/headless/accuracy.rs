@@ -272,9 +272,9 @@ fn record_every(dt: f64) -> usize {
     ((SAMPLE_DT / dt).round() as usize).max(1)
 }
 
-/// The DDA run of a case at the finest time step (the default scheme), to measure what
+/// The DDA run of a case at the finest time step (generalised-α ρ∞ = 0), to measure what
 /// the time step alone costs: as Δt → 0 every scheme tends to it, and it differs from the
-/// exact mass-spring solution only by the model (penalty springs at the joint).
+/// exact mass-spring solution only by the model (the blocks' and the joint's elasticity).
 fn converged_dda(case: &Case, duration: f64, dt: f64, fixed_base: bool) -> Result<ModelRun> {
     let mut setup = case_spec(case, duration, dt, fixed_base).prepare()?;
     setup.history = HistoryPlan::EverySteps(record_every(dt));

@@ -98,6 +98,9 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
     let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
     let mut step = 0usize;
     let mut last_slip = 0.0;
+    // The last step's row when the stride skipped it: a history ends where the run ends
+    // (one that stopped a few steps short made comparisons of histories clamp there).
+    let mut unrecorded = None;
     let mut sliding_steps = 0;
     let mut next_report = setup.progress.as_ref().map(|p| p.first_after_s);
     dda.run_until(duration, |d, report| {
@@ -137,16 +140,22 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         series.push(r.time, r.base_accel);
         if record_every > 0 && step.is_multiple_of(record_every) {
             history.push(&row);
+            unrecorded = None;
             // Bounded memory: past the limit, every other row goes and the interval
             // doubles (the kept rows are those of the doubled interval).
             if history.len() >= MAX_HISTORY_ROWS {
                 history.decimate();
                 record_every *= 2;
             }
+        } else {
+            unrecorded = Some(row);
         }
         step += 1;
         last_slip = r.slip;
     })?;
+    if let (true, Some(row)) = (record_every > 0, unrecorded) {
+        history.push(&row);
+    }
     let counters = dda.counters();
     let energy = dda.energy();
     Ok(ModelRun {
