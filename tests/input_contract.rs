@@ -314,7 +314,7 @@ fn a_third_vertex_coordinate_is_an_error_with_its_line() {
     );
     assert_has(
         &scene_error(&text),
-        &["s.toml:38", "two coordinates", "got 3"],
+        &["s.toml:40", "two coordinates", "got 3"],
     );
 }
 
@@ -840,12 +840,12 @@ fn friction_laws_in_a_scene_file_are_parsed_or_refused_with_their_line() {
     ));
     assert_has(
         &scene_error(&with("\"static-kinetic:0.4,0.6\"")),
-        &["s.toml:55", "must not exceed"],
+        &["s.toml:57", "must not exceed"],
     );
     assert_has(
         &scene_error(&with("\"stribeck:0.1\"")),
         &[
-            "s.toml:55",
+            "s.toml:57",
             "static-kinetic:MU_S,MU_K",
             "velocity:MU_SLOW,MU_FAST,RATE",
         ],
