@@ -568,3 +568,30 @@ fn the_friction_law_and_the_block_scenes_are_in_the_panel() {
         assert_eq!(run.models.len(), 2, "{scene:?} and its fixed base");
     }
 }
+
+/// The integrator combo starts on the scene's choice (the run asks for none, so the
+/// two-block scene gets its ρ∞ = 0.5 and the frames their ρ∞ = 0), and a scheme picked in
+/// it by name is the one the next run uses.
+#[test]
+fn the_integrator_is_the_scenes_until_one_is_picked() {
+    let mut h = harness(AppState::default(), 1600.0, 900.0);
+    assert_eq!(h.state().controls.config().integrator, None);
+    let run = slidebase::sim::prepare(&h.state().controls.config()).expect("it sets up");
+    assert_eq!(
+        run.models[0].0.params().integrator,
+        slidebase::dda::Integrator::default()
+    );
+    h.state_mut().take_commands();
+    h.get_by_label("solver settings").click();
+    h.run_steps(2);
+    h.get_by_value("the scene's choice").click();
+    h.run_steps(2);
+    h.get_by_label("trapezoidal (no numerical damping)").click();
+    h.run_steps(2);
+    let r = runs(&h.state_mut().take_commands());
+    let last = r.last().expect("picking a scheme restarts the run");
+    assert_eq!(
+        last.integrator,
+        Some(slidebase::dda::Integrator::Trapezoidal)
+    );
+}
