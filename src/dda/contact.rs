@@ -73,6 +73,9 @@ pub struct ContactMemory {
     pub shear_multiplier: f64,
     /// How much the shear multiplier changed over the last step (while locked), N.
     pub shear_change: f64,
+    /// Gap at the end of the last step as that step's linear motion put it, m (the
+    /// geometry update departs from it: see `Dda::constraint_drift_work`).
+    pub gap: f64,
 }
 
 /// A contact during one step: geometry linearised at the step start plus its trial state.

@@ -28,7 +28,9 @@ pub struct EnergyTerms {
     /// impact steps remove is counted here rather than as numerical dissipation.
     pub impact_dissipated: f64,
     /// What the time integrator dissipated (positive) or created (negative), computed
-    /// from its own states (see `Dda::commit_step`); zero for the trapezoidal rule.
+    /// from its own states (see `Dda::commit_step`; zero for the trapezoidal rule), and
+    /// what the exact constraints took back from the geometry update's departure from
+    /// the linear step (see `Dda::constraint_drift_work`).
     pub numerical_dissipated: f64,
 }
 

@@ -651,6 +651,35 @@ impl LinearSolver {
         })
     }
 
+    /// Whether the last solve was by conjugate gradients on a kept factor (whose residual
+    /// is small relative to ‖K‖‖x‖, not row by row), rather than by a fresh factor.
+    pub fn last_solve_iterated(&self) -> bool {
+        !self.fresh
+    }
+
+    /// One step of iterative refinement for the residual `r` = R − K x of the last solve:
+    /// adds F⁻¹ r to `x`, F the kept factor, if that at least halves the residual (the
+    /// factor was made for a nearby matrix: the step is cheap, but a factor far from K
+    /// could amplify the residual instead); false, `x` untouched, if not.
+    pub fn refine(&mut self, k: &BlockMatrix, r: &[f64], x: &mut [f64]) -> bool {
+        let norm = |v: &[f64]| v.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+        let [mut delta, z, p, mut q] = std::mem::take(&mut self.work);
+        delta.copy_from_slice(r);
+        self.apply_inverse(&mut delta);
+        k.mul(&delta, &mut q);
+        for (qi, ri) in q.iter_mut().zip(r) {
+            *qi = ri - *qi;
+        }
+        let better = norm(&q) <= 0.5 * norm(r);
+        if better {
+            for (xi, di) in x.iter_mut().zip(&delta) {
+                *xi += di;
+            }
+        }
+        self.work = [delta, z, p, q];
+        better
+    }
+
     /// Counters so far.
     pub fn stats(&self) -> SolverStats {
         self.stats

@@ -17,6 +17,7 @@ impl Dda {
                 normal_change: 0.0,
                 shear_multiplier: 0.0,
                 shear_change: 0.0,
+                gap: c.gap0,
             });
             m.state = c.state;
             m.shear = 0.0;
@@ -58,7 +59,10 @@ impl Dda {
         } else {
             Vec::new()
         };
-        for _ in 0..=MAX_FLIPS_PER_STEP {
+        for round in 0..=MAX_FLIPS_PER_STEP {
+            // The last round keeps the states it starts with: a flip there would leave
+            // the accelerations projected on the states before it.
+            let may_flip = round < MAX_FLIPS_PER_STEP;
             for (b, saved) in self.blocks.iter_mut().zip(&before) {
                 [b.velocity, b.accel, b.response_accel] = *saved;
             }
@@ -101,7 +105,9 @@ impl Dda {
                 }
                 let normal = c.start_normal + dn;
                 let shear = c.start_shear_multiplier + ds;
-                let new_state = if normal < 0.0 {
+                let new_state = if !may_flip {
+                    c.start_state
+                } else if normal < 0.0 {
                     ContactState::Open
                 } else if c.start_state == ContactState::Locked
                     && shear.abs() > c.props.friction.sticking_coefficient() * normal * (1.0 + 1e-9)
@@ -206,8 +212,10 @@ impl Dda {
         // where the updates stall (at ~2e-14 of it: the round-off of the constraint rates
         // times the penalty). A gentle stick-slip event, whose impulse is ~1e-8 of the
         // momentum, otherwise never met the relative tolerance: it ran all 200 updates
-        // and was then left unprojected (the three-storey frame's slab: every event).
+        // (the three-storey frame's slab: every event).
         let momentum = base.r.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+        let mut x = self.increments(&solution, &still);
+        let mut converged = false;
         for _ in 0..200 {
             let mut sys = base.clone();
             for (c, m) in self.contacts.iter().zip(&multipliers) {
@@ -238,7 +246,7 @@ impl Dda {
             self.linear
                 .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
                 .map_err(|e| self.solve_error(e))?;
-            let x = self.increments(&solution, &still);
+            x = self.increments(&solution, &still);
             let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
             for (c, m) in self.contacts.iter().zip(multipliers.iter_mut()) {
                 let p = c.props.normal_penalty / mass_factor;
@@ -264,12 +272,26 @@ impl Dda {
                 || scale <= 1e-10 * momentum
                 || worst <= 1e-12 * momentum
             {
-                for (bi, b) in self.blocks.iter_mut().enumerate() {
-                    if self.dofs.slot[bi].is_some() {
-                        *field.of_mut(b) = x[bi];
-                    }
-                }
+                converged = true;
                 break;
+            }
+        }
+        // Accelerations are kept from the last solve even when the updates did not meet
+        // the tolerances (they stall at round-off, up to ~1e-10 of the momentum: 4.7e-4 N
+        // of 3.5e7 on the three-storey base): that field is balanced by the multipliers
+        // returned (the solve applied the old ones and the penalty on g, which is the
+        // update), and the event's resolution remembers these as the contact forces.
+        // Left unprojected, the next step started out of balance with its memory (the
+        // sliding three-storey base over El Centro: ~−10 J unbooked at ten landings,
+        // −1.1e-6 of the energy through it). Velocities are left unprojected as before:
+        // their impulses are not remembered, and the kinetic energy a projection removes
+        // is booked as the impact's. (Applied as well, the overturning block took
+        // another path, on which its residual was 6.6e-2: not understood yet.)
+        if converged || matches!(field, Field::Response) {
+            for (bi, b) in self.blocks.iter_mut().enumerate() {
+                if self.dofs.slot[bi].is_some() {
+                    *field.of_mut(b) = x[bi];
+                }
             }
         }
         Ok(multipliers)
