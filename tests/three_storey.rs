@@ -116,8 +116,9 @@ fn sliding_frame_matches_the_mdof_model() {
     // when it started from the force at the step start and needed a pass to correct it).
     let passes_per_step = dda.open_close_passes as f64 / dda.steps as f64;
     assert!(passes_per_step < 1.1, "{passes_per_step} passes per step");
+    // Issue 13's target for the energy balance (measured −3.6e-8).
     assert!(
-        dda.energy_residual_rel.abs() < 0.01,
+        dda.energy_residual_rel.abs() < 1e-6,
         "energy residual {}",
         dda.energy_residual_rel
     );
@@ -151,6 +152,43 @@ fn fixed_base_frame_matches_the_mdof_model() {
         "a bonded joint does not slide: {}",
         dda.max_slip_m
     );
+    // Issue 13's target (measured −1.2e-11; 5e-6 before the bonded corners' lift by the
+    // exact rotation update was booked and the kept factor's solves refined).
+    assert!(
+        dda.energy_residual_rel.abs() < 1e-6,
+        "energy residual {}",
+        dda.energy_residual_rel
+    );
+}
+
+/// Issue 13: with the non-dissipative trapezoidal rule at Δt = 1 ms the energy balance
+/// closes to 1e-6 of the energy through the frame on every shipped horizontal record,
+/// sliding and fixed base (measured: at most 7.5e-8 sliding, 1.8e-9 fixed). Slow:
+/// `cargo test --release -- --ignored`.
+#[test]
+#[ignore]
+fn the_energy_balance_closes_on_every_shipped_record() {
+    use slidebase::dda::Integrator;
+    for name in slidebase::ground_motion::builtin_names() {
+        let record = slidebase::ground_motion::builtin_record(name).unwrap();
+        if record.is_vertical() {
+            continue;
+        }
+        for fixed_base in [false, true] {
+            let req = RunSpec {
+                excitation: ExcitationSpec::record(name),
+                integrator: Some(Integrator::Trapezoidal),
+                fixed_base,
+                ..RunSpec::scene("three-storey")
+            };
+            let s = run_frame(&req).unwrap().summary;
+            assert!(
+                s.energy_residual_rel.abs() < 1e-6,
+                "{name}, fixed base {fixed_base}: energy residual {:.2e}",
+                s.energy_residual_rel
+            );
+        }
+    }
 }
 
 /// A frame settled under its own weight is in equilibrium: a dynamic run under the same
