@@ -388,12 +388,8 @@ impl AppState {
     }
 
     fn section_solver(&mut self, ui: &mut egui::Ui) {
-        let selected = self
-            .controls
-            .integrator
-            .map_or("the scene's choice".to_string(), |i| i.label());
         egui::ComboBox::from_id_salt("integrator")
-            .selected_text(selected)
+            .selected_text(integrator_text(self.controls.integrator))
             .width(COMBO_WIDTH)
             .truncate()
             .show_ui(ui, |ui| {
@@ -596,10 +592,15 @@ impl AppState {
         if let Some(c) = &self.timeline.config {
             ui.label(format!(
                 "integrator {}, Δt {} s",
-                c.integrator
-                    .map_or("as the scene asks".to_string(), |i| i.label()),
+                integrator_text(c.integrator),
                 crate::post::format_number(c.dt)
             ));
         }
     }
+}
+
+/// How a run's integrator choice reads in the panel: the scheme's command-line spelling,
+/// or the scene's choice when the run names none.
+fn integrator_text(integrator: Option<Integrator>) -> String {
+    integrator.map_or("the scene's choice".to_string(), |i| i.label())
 }

@@ -214,8 +214,8 @@ impl Dda {
         // momentum, otherwise never met the relative tolerance: it ran all 200 updates
         // (the three-storey frame's slab: every event).
         let momentum = base.r.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
-        let mut x = self.increments(&solution, &still);
-        let mut converged = false;
+        // The last solve's field, and whether its updates met the tolerances.
+        let mut last: Option<(PerBlock<Vec6>, bool)> = None;
         for _ in 0..200 {
             let mut sys = base.clone();
             for (c, m) in self.contacts.iter().zip(&multipliers) {
@@ -246,7 +246,7 @@ impl Dda {
             self.linear
                 .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
                 .map_err(|e| self.solve_error(e))?;
-            x = self.increments(&solution, &still);
+            let x = self.increments(&solution, &still);
             let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
             for (c, m) in self.contacts.iter().zip(multipliers.iter_mut()) {
                 let p = c.props.normal_penalty / mass_factor;
@@ -268,11 +268,11 @@ impl Dda {
                     scale = scale.max(m[1].abs());
                 }
             }
-            if worst <= self.params.constraint_tolerance * scale
+            let converged = worst <= self.params.constraint_tolerance * scale
                 || scale <= 1e-10 * momentum
-                || worst <= 1e-12 * momentum
-            {
-                converged = true;
+                || worst <= 1e-12 * momentum;
+            last = Some((x, converged));
+            if converged {
                 break;
             }
         }
@@ -287,7 +287,10 @@ impl Dda {
         // their impulses are not remembered, and the kinetic energy a projection removes
         // is booked as the impact's. (Applied as well, the overturning block took
         // another path, on which its residual was 6.6e-2: not understood yet.)
-        if converged || matches!(field, Field::Response) {
+        let keep = |&(_, converged): &(PerBlock<Vec6>, bool)| {
+            converged || matches!(field, Field::Response)
+        };
+        if let Some((x, _)) = last.filter(keep) {
             for (bi, b) in self.blocks.iter_mut().enumerate() {
                 if self.dofs.slot[bi].is_some() {
                     *field.of_mut(b) = x[bi];
