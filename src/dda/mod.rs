@@ -15,6 +15,7 @@ pub mod integrator;
 pub mod joints;
 pub mod judge;
 pub mod linear;
+pub mod mat6;
 pub mod params;
 pub mod rayleigh;
 pub mod solver;

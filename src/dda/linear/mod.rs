@@ -26,9 +26,12 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, MatMut, Par, Side};
+use faer::{Conj, Par, Side};
 
 use super::block::Mat6;
+use envelope::{Envelope, EnvelopeCholesky};
+
+mod envelope;
 
 /// Which 6×6 blocks of the matrix can be non-zero: pairs (i, j), i ≤ j, of free blocks
 /// (numbered in unknown order: block k owns unknowns 6k..6k+6).
@@ -335,12 +338,6 @@ impl BlockMatrix {
         }
     }
 
-    /// Writes the lower triangle of the dense matrix into `a` (n × n, zeroed here).
-    fn fill_dense_lower(&self, mut a: MatMut<'_, f64>) {
-        a.fill(0.0);
-        self.for_each_lower(|row, col, v| a[(row, col)] = v);
-    }
-
     /// Writes the upper-triangle compressed-column values.
     fn fill_compressed(&self, values: &mut [f64]) {
         for (e, block) in self.blocks.iter().enumerate() {
@@ -379,23 +376,19 @@ pub struct SolverStats {
     pub iterations: u64,
 }
 
-/// Systems up to this many unknowns are factorised dense: below it the sparse machinery
-/// (ordering, indirection) costs more than the arithmetic it saves.
-const DENSE_LIMIT: usize = 120;
+/// Systems up to this many unknowns are always factorised on their envelope: below it
+/// the sparse machinery (supernodes, dispatch) costs more than the arithmetic it saves.
+/// Larger ones are too when their envelope holds no more than the sparse factor does.
+const ENVELOPE_LIMIT: usize = 120;
 
 /// How many conjugate-gradient iterations one factorisation is worth, from operation
 /// counts: the kept factor is used until the iterations spent on it would have paid for a
 /// new factorisation (so the total never exceeds twice the better of the two policies, a
 /// deterministic choice that does not depend on timings). An iteration costs two
-/// triangular solves and a product, ~4·nnz(L) + 2·nnz(K); a factorisation
-/// ~nnz(L)²/n for a sparse factor and n³/3 for a dense one.
-fn iteration_budget(n: usize, factor_nonzeros: usize, matrix_nonzeros: usize) -> usize {
-    let (n, l, a) = (n as f64, factor_nonzeros as f64, matrix_nonzeros as f64);
-    let factorisation = if n <= DENSE_LIMIT as f64 {
-        n * n * n / 3.0
-    } else {
-        l * l / n
-    };
+/// triangular solves and a product, ~4·nnz(L) + 2·nnz(K); a factorisation costs what
+/// the envelope counts, or ~nnz(L)²/n for a sparse factor.
+fn iteration_budget(factorisation: f64, factor_nonzeros: usize, matrix_nonzeros: usize) -> usize {
+    let (l, a) = (factor_nonzeros as f64, matrix_nonzeros as f64);
     (factorisation / (4.0 * l + 2.0 * a)).floor() as usize
 }
 
@@ -470,9 +463,7 @@ impl Tiny {
 #[allow(clippy::large_enum_variant)]
 enum Factor {
     Tiny(Tiny),
-    Dense {
-        l: Mat<f64>,
-    },
+    Envelope(EnvelopeCholesky),
     Sparse {
         symbolic: Arc<SymbolicCholesky<usize>>,
         l_values: Vec<f64>,
@@ -550,9 +541,7 @@ impl Factor {
                 Tiny::B3(_) => Tiny::B3(None),
                 Tiny::B4(_) => Tiny::B4(None),
             }),
-            Factor::Dense { l } => Factor::Dense {
-                l: Mat::zeros(l.nrows(), l.ncols()),
-            },
+            Factor::Envelope(l) => Factor::Envelope(l.empty_like()),
             Factor::Sparse {
                 symbolic,
                 l_values,
@@ -572,7 +561,7 @@ impl Clone for LinearSolver {
         let factor = self.slots[0].factor.empty_like();
         Self {
             pattern: Arc::clone(&self.pattern),
-            scratch: MemBuffer::new(scratch_size(&factor, self.pattern.unknowns())),
+            scratch: MemBuffer::new(scratch_size(&factor)),
             slots: [Slot::new(factor.empty_like()), Slot::new(factor)],
             active: 0,
             budget: self.budget,
@@ -585,17 +574,10 @@ impl Clone for LinearSolver {
     }
 }
 
-fn scratch_size(factor: &Factor, n: usize) -> StackReq {
+fn scratch_size(factor: &Factor) -> StackReq {
     match factor {
         Factor::Tiny(_) => StackReq::EMPTY,
-        Factor::Dense { .. } => StackReq::any_of(&[
-            faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
-                n,
-                Par::Seq,
-                Default::default(),
-            ),
-            faer::linalg::cholesky::llt::solve::solve_in_place_scratch::<f64>(n, 1, Par::Seq),
-        ]),
+        Factor::Envelope(_) => StackReq::EMPTY,
         Factor::Sparse { symbolic, .. } => StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
@@ -608,37 +590,26 @@ impl LinearSolver {
     /// symbolic analysis done here, once) for large ones.
     pub fn new(pattern: Arc<BlockPattern>) -> Result<Self, SolveError> {
         let n = pattern.unknowns();
-        let factor = if let Some(tiny) = Tiny::new(n).filter(|_| n <= TINY_LIMIT) {
-            Factor::Tiny(tiny)
-        } else if n <= DENSE_LIMIT {
-            Factor::Dense {
-                l: Mat::zeros(n, n),
-            }
-        } else {
-            let symbolic = factorize_symbolic_cholesky(
-                pattern.symbolic(),
-                Side::Upper,
-                SymmetricOrdering::Amd,
-                CholeskySymbolicParams::default(),
-            )
-            .map_err(|_| SolveError::OutsidePattern)?;
-            Factor::Sparse {
-                l_values: vec![0.0; symbolic.len_val()],
-                a_values: vec![0.0; pattern.row_idx.len()],
-                symbolic: Arc::new(symbolic),
-            }
+        let factor = match Tiny::new(n).filter(|_| n <= TINY_LIMIT) {
+            Some(tiny) => Factor::Tiny(tiny),
+            None => Self::envelope_or_sparse(&pattern)?,
         };
-        let factor_nonzeros = match &factor {
-            Factor::Tiny(_) | Factor::Dense { .. } => n * (n + 1) / 2,
-            Factor::Sparse { l_values, .. } => l_values.len(),
-        };
-        let budget = match factor {
+        let matrix_nonzeros = 36 * pattern.stored_blocks();
+        let budget = match &factor {
             // Factorising a few blocks costs less than one iteration's bookkeeping.
             Factor::Tiny(_) => 0,
-            _ => iteration_budget(n, factor_nonzeros, 36 * pattern.stored_blocks()),
+            Factor::Envelope(l) => {
+                let envelope = l.envelope();
+                let stored = 36 * envelope.stored_blocks();
+                iteration_budget(envelope.factorisation_cost(), stored, matrix_nonzeros)
+            }
+            Factor::Sparse { l_values, .. } => {
+                let stored = l_values.len() as f64;
+                iteration_budget(stored * stored / n as f64, l_values.len(), matrix_nonzeros)
+            }
         };
         Ok(Self {
-            scratch: MemBuffer::new(scratch_size(&factor, n)),
+            scratch: MemBuffer::new(scratch_size(&factor)),
             slots: [Slot::new(factor.empty_like()), Slot::new(factor)],
             active: 0,
             budget,
@@ -648,6 +619,32 @@ impl LinearSolver {
             change: Vec::new(),
             matrix_norm: None,
             pattern,
+        })
+    }
+
+    /// The factor of a system too large for [`Tiny`]: on its envelope when that is small
+    /// or holds no more than the sparse factor, else sparse (with the symbolic analysis
+    /// done here, once).
+    fn envelope_or_sparse(pattern: &BlockPattern) -> Result<Factor, SolveError> {
+        let envelope = Envelope::new(pattern);
+        let envelope_values = 36 * envelope.stored_blocks();
+        if pattern.unknowns() <= ENVELOPE_LIMIT {
+            return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
+        }
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.symbolic(),
+            Side::Upper,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|_| SolveError::OutsidePattern)?;
+        if envelope_values <= symbolic.len_val() {
+            return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
+        }
+        Ok(Factor::Sparse {
+            l_values: vec![0.0; symbolic.len_val()],
+            a_values: vec![0.0; pattern.row_idx.len()],
+            symbolic: Arc::new(symbolic),
         })
     }
 
@@ -861,17 +858,7 @@ impl LinearSolver {
         let stack = MemStack::new(&mut self.scratch);
         match &mut slot.factor {
             Factor::Tiny(tiny) => tiny.factorize(k)?,
-            Factor::Dense { l } => {
-                k.fill_dense_lower(l.as_mut());
-                faer::linalg::cholesky::llt::factor::cholesky_in_place(
-                    l.as_mut(),
-                    LltRegularization::default(),
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .map_err(|_| SolveError::NotPositiveDefinite)?;
-            }
+            Factor::Envelope(l) => l.factorize(k)?,
             Factor::Sparse {
                 symbolic,
                 l_values,
@@ -898,23 +885,19 @@ impl LinearSolver {
     /// x ← K⁻¹ x with the kept factor.
     fn apply_inverse(&mut self, x: &mut [f64]) {
         let n = x.len();
-        let factor = &self.slots[self.active].factor;
+        let factor = &mut self.slots[self.active].factor;
         if let Factor::Tiny(tiny) = factor {
             tiny.solve(x);
+            return;
+        }
+        if let Factor::Envelope(l) = factor {
+            l.solve(x);
             return;
         }
         let mut rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
         let stack = MemStack::new(&mut self.scratch);
         match factor {
-            Factor::Tiny(_) => {}
-            Factor::Dense { l } => {
-                faer::linalg::cholesky::llt::solve::solve_in_place(
-                    l.as_ref(),
-                    rhs.rb_mut(),
-                    Par::Seq,
-                    stack,
-                );
-            }
+            Factor::Tiny(_) | Factor::Envelope(_) => {}
             Factor::Sparse {
                 symbolic, l_values, ..
             } => {

@@ -1,0 +1,131 @@
+//! Kernels on the 6×6 blocks the systems are made of: a block's unknowns are its
+//! translation, rotation and three strains. Written for the fixed size, so that the
+//! compiler unrolls them; used by the envelope factor of the linear solver.
+
+use super::block::{Mat6, Vec6};
+
+/// mᵀ.
+pub fn transpose(m: &Mat6) -> Mat6 {
+    std::array::from_fn(|r| std::array::from_fn(|c| m[c][r]))
+}
+
+/// s ← s − a bᵀ.
+pub fn subtract_product_transposed(s: &mut Mat6, a: &Mat6, b: &Mat6) {
+    for (sr, ar) in s.iter_mut().zip(a) {
+        for (src, bc) in sr.iter_mut().zip(b) {
+            *src -= (0..6).map(|k| ar[k] * bc[k]).sum::<f64>();
+        }
+    }
+}
+
+/// The lower Cholesky factor L of the symmetric positive definite `s` (its lower half
+/// read), in place, its upper half zeroed; the reciprocals of L's diagonal into
+/// `inverse`. `None` if `s` is not positive definite (or not finite).
+pub fn cholesky(s: &mut Mat6, inverse: &mut [f64; 6]) -> Option<()> {
+    for c in 0..6 {
+        let pivot = s[c][c] - (0..c).map(|k| s[c][k] * s[c][k]).sum::<f64>();
+        if pivot.is_nan() || pivot <= 0.0 {
+            return None;
+        }
+        let l = pivot.sqrt();
+        s[c][c] = l;
+        inverse[c] = 1.0 / l;
+        for r in c + 1..6 {
+            s[r][c] = (s[r][c] - (0..c).map(|k| s[r][k] * s[c][k]).sum::<f64>()) * inverse[c];
+        }
+        for value in &mut s[c][c + 1..] {
+            *value = 0.0;
+        }
+    }
+    Some(())
+}
+
+/// s ← s L⁻ᵀ for a lower triangular L (row by row: x Lᵀ = s is a forward substitution).
+pub fn divide_by_transposed(s: &mut Mat6, l: &Mat6, inverse: &[f64; 6]) {
+    for row in s.iter_mut() {
+        for c in 0..6 {
+            row[c] = (row[c] - (0..c).map(|k| row[k] * l[c][k]).sum::<f64>()) * inverse[c];
+        }
+    }
+}
+
+/// y ← L⁻¹ y.
+pub fn forward(l: &Mat6, inverse: &[f64; 6], y: &mut Vec6) {
+    for c in 0..6 {
+        y[c] = (y[c] - (0..c).map(|k| l[c][k] * y[k]).sum::<f64>()) * inverse[c];
+    }
+}
+
+/// y ← L⁻ᵀ y.
+pub fn backward(l: &Mat6, inverse: &[f64; 6], y: &mut Vec6) {
+    for c in (0..6).rev() {
+        y[c] = (y[c] - (c + 1..6).map(|k| l[k][c] * y[k]).sum::<f64>()) * inverse[c];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// m⁻¹ r by the factor and the two triangular solves.
+    fn solve_spd(m: &Mat6, r: &Vec6) -> Option<Vec6> {
+        let mut l = *m;
+        let mut inverse = [0.0; 6];
+        cholesky(&mut l, &mut inverse)?;
+        let mut x = *r;
+        forward(&l, &inverse, &mut x);
+        backward(&l, &inverse, &mut x);
+        Some(x)
+    }
+
+    /// An SPD matrix: a diagonal plus u uᵀ plus v vᵀ, as a block's mass matrix is.
+    fn spd() -> Mat6 {
+        let u = [1.0, -0.5, 0.25, 2.0, 0.0, 0.3];
+        let v = [0.2, 0.1, -1.0, 0.0, 0.7, 0.4];
+        std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                u[r] * u[c] + v[r] * v[c] + if r == c { 1.0 + r as f64 } else { 0.0 }
+            })
+        })
+    }
+
+    #[test]
+    fn the_factor_solves_the_system() {
+        let m = spd();
+        let r = [1.0, 2.0, 3.0, -1.0, 0.5, 0.0];
+        let x = solve_spd(&m, &r).expect("positive definite");
+        for i in 0..6 {
+            let mx: f64 = (0..6).map(|j| m[i][j] * x[j]).sum();
+            assert!(
+                (mx - r[i]).abs() < 1e-13 * 3.0,
+                "row {i}: {mx} against {}",
+                r[i]
+            );
+        }
+    }
+
+    #[test]
+    fn an_indefinite_or_nan_matrix_is_refused() {
+        let mut m = spd();
+        m[2][2] = -1.0;
+        assert!(solve_spd(&m, &[0.0; 6]).is_none());
+        let mut m = spd();
+        m[4][4] = f64::NAN;
+        assert!(solve_spd(&m, &[0.0; 6]).is_none());
+    }
+
+    #[test]
+    fn the_factor_times_its_transpose_is_the_matrix() {
+        let m = spd();
+        let mut l = m;
+        let mut inverse = [0.0; 6];
+        cholesky(&mut l, &mut inverse).expect("positive definite");
+        let mut llt = [[0.0; 6]; 6];
+        subtract_product_transposed(&mut llt, &l, &l);
+        for r in 0..6 {
+            for c in 0..6 {
+                assert!((-llt[r][c] - m[r][c]).abs() < 1e-13 * 10.0);
+            }
+        }
+    }
+}
