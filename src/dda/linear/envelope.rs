@@ -70,7 +70,9 @@ impl Envelope {
                 // K's block (a, b) is stored as (min, max); the diagonal is read from its
                 // upper half, i.e. transposed, as the lower half is not kept.
                 source.push(pattern.entry(a.min(b), a.max(b)).map(|e| (e, a >= b)));
-                let products = column - first[row].max(first[column]);
+                // A row inside the band need not reach back to this column (its block is
+                // then fill from the rows below it, or zero): no products for it.
+                let products = column.saturating_sub(first[row].max(first[column]));
                 factorisation_cost += 216.0 * products as f64 + 126.0;
             }
             column_start.push(source.len());
