@@ -164,7 +164,11 @@ fn fixed_base_frame_matches_the_mdof_model() {
 /// Issue 13: with the non-dissipative trapezoidal rule at Δt = 1 ms the energy balance
 /// closes to 1e-6 of the energy through the frame on every shipped horizontal record,
 /// sliding and fixed base (measured: at most 7.5e-8 sliding, 1.8e-9 fixed). Slow:
-/// `cargo test --release -- --ignored`.
+/// `cargo test --release -- --ignored`. Known blind spot: on Chi-Chi the sliding frame
+/// sags in the record's last 30 s under this rule (a growing Nyquist shear oscillation of
+/// the columns; see NOTES-issue-13.md, stop 30), which this balance cannot see because
+/// the strain energy takes the gravity work; a change of rounding can tip that run into a
+/// bad impact and fail this test.
 #[test]
 #[ignore]
 fn the_energy_balance_closes_on_every_shipped_record() {

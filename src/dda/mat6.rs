@@ -49,6 +49,20 @@ pub fn divide_by_transposed(s: &mut Mat6, l: &Mat6, inverse: &[f64; 6]) {
     }
 }
 
+/// y ← y − m x.
+pub fn subtract_product(y: &mut Vec6, m: &Mat6, x: &Vec6) {
+    for (yr, mr) in y.iter_mut().zip(m) {
+        *yr -= (0..6).map(|c| mr[c] * x[c]).sum::<f64>();
+    }
+}
+
+/// y ← y − mᵀ x.
+pub fn subtract_transposed_product(y: &mut Vec6, m: &Mat6, x: &Vec6) {
+    for (c, yc) in y.iter_mut().enumerate() {
+        *yc -= (0..6).map(|r| m[r][c] * x[r]).sum::<f64>();
+    }
+}
+
 /// y ← L⁻¹ y.
 pub fn forward(l: &Mat6, inverse: &[f64; 6], y: &mut Vec6) {
     for c in 0..6 {

@@ -15,7 +15,8 @@ use std::sync::Arc;
 use super::{BlockMatrix, BlockPattern, SolveError};
 use crate::dda::block::Mat6;
 use crate::dda::mat6::{
-    backward, cholesky, divide_by_transposed, forward, subtract_product_transposed, transpose,
+    backward, cholesky, divide_by_transposed, forward, subtract_product,
+    subtract_product_transposed, subtract_transposed_product, transpose,
 };
 
 /// The reordering and the block structure of the factor, shared by the factors of one
@@ -220,21 +221,14 @@ impl EnvelopeCholesky {
             forward(diagonal, &inverse_diagonal[column], &mut y[column]);
             let solved = y[column];
             for row in column + 1..column + envelope.rows(column) {
-                let block = &blocks[envelope.at(row, column)];
-                for (r, yr) in y[row].iter_mut().enumerate() {
-                    *yr -= (0..6).map(|c| block[r][c] * solved[c]).sum::<f64>();
-                }
+                subtract_product(&mut y[row], &blocks[envelope.at(row, column)], &solved);
             }
         }
         // Backward, Lᵀ x = z.
         for column in (0..columns).rev() {
             let mut acc = y[column];
             for row in column + 1..column + envelope.rows(column) {
-                let block = &blocks[envelope.at(row, column)];
-                let solved = &y[row];
-                for (c, a) in acc.iter_mut().enumerate() {
-                    *a -= (0..6).map(|r| block[r][c] * solved[r]).sum::<f64>();
-                }
+                subtract_transposed_product(&mut acc, &blocks[envelope.at(row, column)], &y[row]);
             }
             let diagonal = &blocks[envelope.at(column, column)];
             backward(diagonal, &inverse_diagonal[column], &mut acc);

@@ -1,5 +1,7 @@
 //! The step's linear system `K D = R`: a symmetric matrix of 6×6 blocks on a pattern that
-//! is fixed for the whole run, and its solution with faer.
+//! is fixed for the whole run, and its solution by Cholesky factors — of a fixed size for
+//! the smallest models, on the envelope of the reordered matrix for small and banded ones
+//! (`envelope.rs`), faer's sparse factor for the rest.
 //!
 //! Which blocks can couple is known when the model is built: every free block with
 //! itself, the blocks a joint (bolt, support, connection element) ties together, and the
@@ -20,7 +22,6 @@ use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
     factorize_symbolic_cholesky,
@@ -576,8 +577,7 @@ impl Clone for LinearSolver {
 
 fn scratch_size(factor: &Factor) -> StackReq {
     match factor {
-        Factor::Tiny(_) => StackReq::EMPTY,
-        Factor::Envelope(_) => StackReq::EMPTY,
+        Factor::Tiny(_) | Factor::Envelope(_) => StackReq::EMPTY,
         Factor::Sparse { symbolic, .. } => StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
@@ -586,8 +586,9 @@ fn scratch_size(factor: &Factor) -> StackReq {
 }
 
 impl LinearSolver {
-    /// A solver for matrices on `pattern`: dense for small systems, sparse (with the
-    /// symbolic analysis done here, once) for large ones.
+    /// A solver for matrices on `pattern`: a fixed-size factor for up to four blocks,
+    /// else the factor on the envelope or the sparse one (see
+    /// [`LinearSolver::envelope_or_sparse`]).
     pub fn new(pattern: Arc<BlockPattern>) -> Result<Self, SolveError> {
         let n = pattern.unknowns();
         let factor = match Tiny::new(n).filter(|_| n <= TINY_LIMIT) {
@@ -627,7 +628,6 @@ impl LinearSolver {
     /// done here, once).
     fn envelope_or_sparse(pattern: &BlockPattern) -> Result<Factor, SolveError> {
         let envelope = Envelope::new(pattern);
-        let envelope_values = 36 * envelope.stored_blocks();
         if pattern.unknowns() <= ENVELOPE_LIMIT {
             return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
         }
@@ -638,7 +638,7 @@ impl LinearSolver {
             CholeskySymbolicParams::default(),
         )
         .map_err(|_| SolveError::OutsidePattern)?;
-        if envelope_values <= symbolic.len_val() {
+        if 36 * envelope.stored_blocks() <= symbolic.len_val() {
             return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
         }
         Ok(Factor::Sparse {
@@ -885,27 +885,18 @@ impl LinearSolver {
     /// x ← K⁻¹ x with the kept factor.
     fn apply_inverse(&mut self, x: &mut [f64]) {
         let n = x.len();
-        let factor = &mut self.slots[self.active].factor;
-        if let Factor::Tiny(tiny) = factor {
-            tiny.solve(x);
-            return;
-        }
-        if let Factor::Envelope(l) = factor {
-            l.solve(x);
-            return;
-        }
-        let mut rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
-        let stack = MemStack::new(&mut self.scratch);
-        match factor {
-            Factor::Tiny(_) | Factor::Envelope(_) => {}
+        match &mut self.slots[self.active].factor {
+            Factor::Tiny(tiny) => tiny.solve(x),
+            Factor::Envelope(l) => l.solve(x),
             Factor::Sparse {
                 symbolic, l_values, ..
             } => {
+                let rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
                 LltRef::<'_, usize, f64>::new(symbolic, l_values).solve_in_place_with_conj(
                     Conj::No,
-                    rhs.rb_mut(),
+                    rhs,
                     Par::Seq,
-                    stack,
+                    MemStack::new(&mut self.scratch),
                 );
             }
         }
