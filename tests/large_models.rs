@@ -132,7 +132,7 @@ fn a_long_run_reports_its_progress() {
 }
 
 /// The paper's frame stands up to `MAX_FRAME_STOREYS` storeys (its first sway mode has a
-/// positive frequency, though P-Δ has taken most of it: 0.638 Hz at 3 storeys), and one
+/// positive frequency, though P-Δ has taken most of it: 0.634 Hz at 3 storeys), and one
 /// storey more is refused with the reason, not left to fail in the settle.
 #[test]
 fn the_tallest_frame_stands_and_a_taller_one_is_refused() {
@@ -142,13 +142,15 @@ fn the_tallest_frame_stands_and_a_taller_one_is_refused() {
         .unwrap()
         .frequencies_hz[0];
     assert!(
-        first > 0.01 && first < 0.638,
+        first > 0.01 && first < 0.634,
         "first sway frequency {first} Hz"
     );
     let taller = format!("frame:{}", MAX_FRAME_STOREYS + 1);
     let e = resolve_scene(&taller).unwrap_err().to_string();
     assert!(
-        e.contains("--scene") && e.contains("buckles") && e.contains("frame:21"),
+        e.contains("--scene")
+            && e.contains("buckles")
+            && e.contains(&format!("frame:{MAX_FRAME_STOREYS}")),
         "{e}"
     );
 }

@@ -164,11 +164,10 @@ fn fixed_base_frame_matches_the_mdof_model() {
 /// Issue 13: with the non-dissipative trapezoidal rule at Δt = 1 ms the energy balance
 /// closes to 1e-6 of the energy through the frame on every shipped horizontal record,
 /// sliding and fixed base (measured: at most 7.5e-8 sliding, 1.8e-9 fixed). Slow:
-/// `cargo test --release -- --ignored`. Known blind spot: on Chi-Chi the sliding frame
-/// sags in the record's last 30 s under this rule (a growing Nyquist shear oscillation of
-/// the columns; see NOTES-issue-13.md, stop 30), which this balance cannot see because
-/// the strain energy takes the gravity work; a change of rounding can tip that run into a
-/// bad impact and fail this test.
+/// `cargo test --release -- --ignored`. A balance that closes cannot see a structure
+/// that turns its weight's work into strain for the wrong reason (the Chi-Chi sag of
+/// stop 30, where the strain energy took the gravity work): the frame's height is
+/// checked by `the_frame_keeps_its_height_on_long_strong_records`.
 #[test]
 #[ignore]
 fn the_energy_balance_closes_on_every_shipped_record() {
@@ -186,6 +185,10 @@ fn the_energy_balance_closes_on_every_shipped_record() {
                 ..RunSpec::scene("three-storey")
             };
             let s = run_frame(&req).unwrap().summary;
+            println!(
+                "{name}, fixed base {fixed_base}: energy residual {:.2e}",
+                s.energy_residual_rel
+            );
             assert!(
                 s.energy_residual_rel.abs() < 1e-6,
                 "{name}, fixed base {fixed_base}: energy residual {:.2e}",
@@ -197,8 +200,11 @@ fn the_energy_balance_closes_on_every_shipped_record() {
 
 /// A frame settled under its own weight is in equilibrium: a dynamic run under the same
 /// load, with no earthquake, leaves it at rest (trapezoidal rule, 2 s), fixed base and on
-/// its sliding joint. Gravity does no work and nothing moves but round-off: the floors'
-/// weight is 5e8 N, and 1e-6 J of work is a settlement of 2e-15 m. (Before the settled
+/// its sliding joint. Gravity does no work and nothing moves but round-off. The
+/// connections' strain is read from their nodes' positions (stop 31), whose round-off,
+/// ε·H for a frame of height H, walks at random over the N steps: a settlement of
+/// ε·H·√N ≈ 1e-13 m, 5e-5 J of the floors' weight (5e8 N); the work is held to ten
+/// times that (measured 4.2e-5 J fixed base). (Before the settled
 /// state was refined to the forces of its own geometry, and before each step's
 /// accelerations were made to balance the forces of the geometry it moved to, the frame
 /// crept: 6.6e4 J of gravity work and 131 J of kinetic energy in 10 s.)
@@ -215,6 +221,13 @@ fn a_settled_frame_stays_at_rest_under_gravity() {
             ..Default::default()
         };
         let mut dda = Dda::new(&scene, None, params).unwrap();
+        let free = || dda.blocks().iter().filter(|b| b.name != "ground");
+        let weight: f64 = free().map(|b| b.total_mass() * 9.80665).sum();
+        let height = free()
+            .flat_map(|b| b.vertices.iter().map(|v| v[1]))
+            .fold(0.0_f64, f64::max);
+        let steps = 2.0 / dda.params().dt;
+        let round_off_work = 10.0 * weight * f64::EPSILON * height * steps.sqrt();
         let mut fastest = 0.0_f64;
         dda.run_until(2.0, |d, _| {
             for b in d.blocks() {
@@ -228,8 +241,10 @@ fn a_settled_frame_stays_at_rest_under_gravity() {
             "fixed base {fixed_base}: a block moved at {fastest:.2e} m/s"
         );
         assert!(
-            e.external_work.abs() < 1e-6 && e.kinetic < 1e-12 && e.residual().abs() < 1e-6,
-            "fixed base {fixed_base}: {e:?}"
+            e.external_work.abs() < round_off_work
+                && e.kinetic < 1e-12
+                && e.residual().abs() < 1e-6,
+            "fixed base {fixed_base}: {e:?}, round-off bound {round_off_work:.2e} J"
         );
     }
 }
@@ -274,5 +289,63 @@ fn every_shipped_record_runs_to_the_end() {
             "{name}: slip {:.3} m, roof {:.3} g, energy residual {:.2e}",
             s.max_slip_m, s.peak_roof_accel_g, s.energy_residual_rel
         );
+    }
+}
+
+/// The frame keeps its height: under the trapezoidal rule its roof's mean height over the
+/// last 8 s of the record stays within the drop its sway explains by geometry alone — a
+/// storey that leans by its drift D lowers its top by D²/2h at most (h the storey
+/// height; D is the roof's peak drift, so the bound counts all the drift in one storey).
+/// On the 90 s Chi-Chi record the connections' summed strains once lost the area the
+/// columns' step-to-step shear took (Δγ²/4 per step) with no stress to resist it, and the
+/// floors sank 8.8 cm (bound 0.2 mm), gravity doing 34 MJ of work against 3.5 MJ of input;
+/// the energy balance closed all the same. Kobe is the strongest shipped record. Slow:
+/// `cargo test --release -- --ignored`.
+#[test]
+#[ignore]
+fn the_frame_keeps_its_height_on_long_strong_records() {
+    use slidebase::dda::Integrator;
+    for name in ["chi-chi-tcu045-n", "kobe-nishi-akashi-000"] {
+        for fixed_base in [false, true] {
+            let req = RunSpec {
+                excitation: ExcitationSpec::record(name),
+                integrator: Some(Integrator::Trapezoidal),
+                fixed_base,
+                ..RunSpec::scene("three-storey")
+            };
+            let setup = req.prepare().unwrap();
+            let (mut dda, probe) = setup
+                .build_dda(&setup.scene, setup.solver_params())
+                .unwrap();
+            let column = dda.block_index("column-1-left").unwrap();
+            let ys = dda.blocks()[column].vertices.iter().map(|v| v[1]);
+            let storey = ys.clone().fold(f64::MIN, f64::max) - ys.fold(f64::MAX, f64::min);
+            let height = |d: &slidebase::dda::Dda| d.blocks()[probe.roof].moments.centroid[1];
+            let drift = |d: &slidebase::dda::Dda| {
+                d.blocks()[probe.roof].centroid_displacement()[0]
+                    - d.blocks()[probe.base].centroid_displacement()[0]
+            };
+            let settled = height(&dda);
+            let (mut peak_drift, mut sum, mut samples) = (0.0_f64, 0.0, 0);
+            let window_start = setup.duration - 8.0;
+            dda.run_until(setup.duration, |d, _| {
+                peak_drift = peak_drift.max(drift(d).abs());
+                if d.time() > window_start {
+                    sum += height(d) - settled;
+                    samples += 1;
+                }
+            })
+            .unwrap();
+            let mean_rise = sum / samples as f64;
+            let bound = peak_drift * peak_drift / (2.0 * storey);
+            println!(
+                "{name}, fixed base {fixed_base}: mean rise {mean_rise:.3e} m, bound {bound:.3e} m"
+            );
+            assert!(
+                mean_rise.abs() < bound,
+                "{name}, fixed base {fixed_base}: the roof's mean height moved by \
+                 {mean_rise:.3e} m, more than the sway's {bound:.3e} m"
+            );
+        }
     }
 }

@@ -299,7 +299,7 @@ pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Benc
             (
                 0.5,
                 &[
-                    "frame:3", "frame:10", "frame:15", "frame:21", "wall:5", "wall:10", "wall:15",
+                    "frame:3", "frame:10", "frame:15", "frame:20", "wall:5", "wall:10", "wall:15",
                     "wall:22", "wall:31",
                 ],
             )

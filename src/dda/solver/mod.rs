@@ -17,8 +17,7 @@ use smallvec::SmallVec;
 
 use super::assembly::{DofMap, System};
 use super::block::{
-    Block, BlockRole, Vec6, displacement_with_rotation, point_displacement, rotation_of,
-    t_transpose_times,
+    Block, BlockRole, StepMap, Vec6, displacement_with_map, point_displacement, t_transpose_times,
 };
 use super::contact::{
     self, Contact, ContactMemories, ContactMemory, ContactPair, JointProps, dot6,
@@ -142,14 +141,14 @@ enum Mode {
 struct StepMotion<'a> {
     centroids: &'a [Point],
     increments: &'a [Vec6],
-    /// Each block's rotation as (sine, cosine): the exact rotation's, or `(r0, 1)` for
-    /// the linear map. Computed once per block, not per node (a frame has ~150 nodes).
-    rotations: &'a [(f64, f64)],
+    /// Each block's step map (exact or linear). Computed once per block, not per node
+    /// (a frame has ~150 nodes).
+    maps: &'a [StepMap],
 }
 
 impl NodeMotion for StepMotion<'_> {
     fn node_displacement(&self, b: usize, x: Point) -> Point {
-        displacement_with_rotation(self.centroids[b], x, &self.increments[b], self.rotations[b])
+        displacement_with_map(self.centroids[b], x, &self.increments[b], &self.maps[b])
     }
 
     fn linear_node_displacement(&self, b: usize, x: Point) -> Point {

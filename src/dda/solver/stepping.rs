@@ -35,14 +35,14 @@ impl Dda {
     /// Moves blocks and joints by the increments and updates the contact memory.
     pub(super) fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
         let centroids = self.centroids();
-        let rotations: PerBlock<(f64, f64)> = increments
+        let maps: PerBlock<StepMap> = increments
             .iter()
-            .map(|d| rotation_of(d, self.params.exact_rotation))
+            .map(|d| StepMap::new(d, self.params.exact_rotation))
             .collect();
         let motion = StepMotion {
             centroids: &centroids,
             increments,
-            rotations: &rotations,
+            maps: &maps,
         };
         self.elements_current = false;
         for b in &mut self.bolts {
