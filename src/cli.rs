@@ -92,7 +92,8 @@ struct RunArgs {
     friction: Option<f64>,
     /// Friction law of the sliding joint: coulomb:MU | static-kinetic:MU_S,MU_K |
     /// velocity:MU_SLOW,MU_FAST,RATE (μ(v) = MU_FAST − (MU_FAST − MU_SLOW)·exp(−RATE·|v|),
-    /// v in m/s, RATE in s/m); DDA only (default: the scene's). See docs/friction-laws.md.
+    /// v in m/s, RATE in s/m); DDA and the exact model alike (default: the scene's). See
+    /// docs/friction-laws.md.
     #[arg(long = "friction-law", conflicts_with = "friction")]
     friction_law: Option<Friction>,
     /// Excitation frequency over the structure frequency, Ω/ω (two-block scenes; default:
@@ -482,7 +483,8 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     }
     let outcome = run_setup(&setup)?;
     if let Some(dir) = &args.out {
-        list_written(write_outputs(&outcome, dir)?, args.json)?;
+        let overlays = slidebase::headless::run::standard_overlays(&setup)?;
+        list_written(write_outputs(&outcome, &overlays, dir)?, args.json)?;
     }
     let s = &outcome.summary;
     if args.json {

@@ -359,8 +359,8 @@ fn sweep_shards_merge_into_the_whole_grid() {
 }
 
 /// `--friction-law` runs a law other than Coulomb's on the sliding joint, and is refused
-/// by name where it cannot be: a law that cannot be, together with `--friction`, and with
-/// the exact model (Coulomb only).
+/// by name where it cannot be (a law that cannot be, or together with `--friction`); the
+/// exact model runs it too.
 #[test]
 fn friction_law_runs_or_is_refused_by_name() {
     let out = slidebase(&[

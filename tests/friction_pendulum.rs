@@ -283,3 +283,33 @@ fn a_slider_bonded_to_its_dish_moves_with_the_ground() {
         );
     }
 }
+
+/// The figure of `run --scene friction-pendulum --out` draws the exact point mass on the
+/// circle and, beside it, the exact block on a flat joint of the same friction, so that
+/// the recentring shows: on El Centro (μ = 0.05) the flat slider ends far off where the
+/// pendulum comes back (docs/friction-pendulum.md's figure: 56 mm against 3 mm).
+#[test]
+fn the_pendulum_figure_draws_the_flat_slider_beside_it() {
+    use slidebase::headless::block::standard_overlays;
+    let spec = RunSpec {
+        excitation: slidebase::setup::ExcitationSpec::record("el-centro".to_string()),
+        friction: Some(0.05),
+        ..RunSpec::scene("friction-pendulum")
+    };
+    let overlays = standard_overlays(&spec.prepare().unwrap()).unwrap();
+    let labels: Vec<&str> = overlays.iter().map(|o| o.label.as_str()).collect();
+    assert_eq!(
+        labels,
+        [
+            "exact point mass on the circle R = 2 m",
+            "exact, on a flat joint"
+        ]
+    );
+    let (pendulum, flat) = (&overlays[0].run, &overlays[1].run);
+    assert!(
+        pendulum.residual_slip_m.abs() < 0.2 * flat.residual_slip_m.abs(),
+        "pendulum {} against flat {}",
+        pendulum.residual_slip_m,
+        flat.residual_slip_m
+    );
+}

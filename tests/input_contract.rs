@@ -594,7 +594,7 @@ fn out_naming_a_file_says_so() {
         ..RunSpec::default()
     })
     .unwrap();
-    let e = write_outputs(&o, &file).unwrap_err().to_string();
+    let e = write_outputs(&o, &[], &file).unwrap_err().to_string();
     assert_has(&e, &["afile", "not a folder"]);
 }
 
@@ -707,7 +707,7 @@ fn a_run_that_fails_while_writing_leaves_no_partial_output() {
     .unwrap();
     setup.history = HistoryPlan::EverySteps(10);
     let o = slidebase::headless::run::run_setup(&setup).unwrap();
-    assert!(write_outputs(&o, dir.path()).is_err());
+    assert!(write_outputs(&o, &[], dir.path()).is_err());
     assert!(!dir.path().join("history.csv").exists());
     assert!(!dir.path().join("summary.json").exists());
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
@@ -889,7 +889,7 @@ fn a_scene_names_its_integrator_and_the_command_line_overrides_it() {
 
 /// A two-block scene whose joint has a static-kinetic law keeps it in a DDA run (the
 /// two-mass parameters set only a Coulomb coefficient, which must not replace it), and
-/// the exact model, which has Coulomb friction only, refuses it by its flag.
+/// in the exact model alike.
 #[test]
 fn a_scene_friction_law_is_kept_by_both_models() {
     use slidebase::model::friction::Friction;

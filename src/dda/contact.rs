@@ -253,19 +253,27 @@ fn surface_edge(block: &Block, k: usize) -> usize {
 }
 
 /// What the contact `key` remembers from the last step: its own memory, or, for a vertex
-/// that moved on to the neighbouring edge of the same block (`edges` edges), that edge's
-/// memory if it was closed — the vertex keeps its state and forces.
+/// that moved on to the neighbouring surface of the same block (`block`, the key's edge
+/// block), that surface's memory if it was closed — the vertex keeps its state and forces.
+/// An arc's neighbours are the edges before its first chord and after its last (the arc
+/// is known by its first chord, so a vertex leaving it over its last end, or arriving
+/// there, would otherwise not find it).
 pub fn remembered(
     memory: &ContactMemories,
     key: ContactKey,
-    edges: usize,
+    block: &Block,
 ) -> Option<ContactMemory> {
     memory.get(&key).copied().or_else(|| {
-        [(key.edge + 1) % edges, (key.edge + edges - 1) % edges]
+        let n = block.vertices.len();
+        let (first, last) = block
+            .arc_of(key.edge)
+            .map_or((key.edge, key.edge), |a| (a.edges[0], a.edges[1]));
+        [(last + 1) % n, (first + n - 1) % n]
             .iter()
             .find_map(|&other| {
+                let edge = surface_edge(block, other);
                 memory
-                    .get(&ContactKey { edge: other, ..key })
+                    .get(&ContactKey { edge, ..key })
                     .copied()
                     .filter(|m| m.state.is_closed())
             })
@@ -352,7 +360,7 @@ fn detect_one_way(
             }
         }
         let Some((key, _, _)) = best else { continue };
-        let mem = remembered(memory, key, ne);
+        let mem = remembered(memory, key, eblock);
         out.push(linearise(vblock, eblock, key, pair, props, mem));
     }
 }
@@ -448,9 +456,67 @@ fn linearise(
 mod tests {
     use super::*;
     use crate::dda::block::point_displacement;
+    use crate::model::scene::ArcDef;
 
     fn block(v: Vec<Point>) -> Block {
         Block::unit_for_tests(v)
+    }
+
+    /// A vertex that leaves a dish's arc over either end, or arrives on it there, keeps
+    /// the memory of the surface it came from (the arc is known by its first chord; over
+    /// its last end the neighbour lookup once missed it).
+    #[test]
+    fn a_vertex_keeps_its_memory_across_either_end_of_an_arc() {
+        // A dish: chords 1..=3 of a circle of radius 2 about (0, 2), between two flats.
+        let r = 2.0_f64;
+        let at = |deg: f64| {
+            let a = deg.to_radians();
+            [r * a.sin(), r - r * a.cos()]
+        };
+        // Counter-clockwise: the chords are edges 2..=4, the flats beside them 1 and 5.
+        let mut dish = block(vec![
+            [3.0, -1.0],
+            [3.0, at(30.0)[1]],
+            at(30.0),
+            at(10.0),
+            at(-10.0),
+            at(-30.0),
+            [-3.0, at(-30.0)[1]],
+            [-3.0, -1.0],
+        ]);
+        dish.arcs = vec![ArcDef {
+            center: [0.0, r],
+            radius: r,
+            edges: [2, 4],
+        }];
+        let key = |edge| ContactKey {
+            vertex_block: 1,
+            vertex: 0,
+            edge_block: 0,
+            edge,
+        };
+        let closed = ContactMemory {
+            state: ContactState::Locked,
+            shear: 0.0,
+            normal_force: 1.0,
+            normal_change: 0.0,
+            shear_multiplier: 0.0,
+            shear_change: 0.0,
+            gap: 0.0,
+        };
+        for (from, to) in [(2, 1), (2, 5), (1, 2), (5, 2)] {
+            let mut memory = ContactMemories::default();
+            memory.insert(key(from), closed);
+            assert_eq!(
+                remembered(&memory, key(to), &dish),
+                Some(closed),
+                "from edge {from} to edge {to}"
+            );
+        }
+        // Not from a surface two edges away.
+        let mut memory = ContactMemories::default();
+        memory.insert(key(6), closed);
+        assert_eq!(remembered(&memory, key(2), &dish), None);
     }
 
     /// The linearised gap matches the exact gap after small motions of both blocks.

@@ -44,7 +44,7 @@ pub struct JudgeInput {
     pub shear_force: f64,
     /// Normal force magnitude at the end of the step, N (≥ 0).
     pub normal_force: f64,
-    /// Coulomb coefficient ρ (may be +∞).
+    /// The law's sticking coefficient (μ_s, μ_slow or Coulomb's ρ; may be +∞).
     pub friction: f64,
     /// Tangential slip of the vertex relative to the edge in this step, m.
     pub slip_increment: f64,

@@ -6,10 +6,10 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::simulate::{self, ModelRun};
-use crate::analytic::{SteppedOptions, simulate_block};
+use crate::analytic::{SlidingBlock, SteppedOptions, Surface, simulate_block};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::history::History;
-use crate::post::plot::{Figure, Series};
+use crate::post::plot::{Figure, Panel, Series};
 use crate::setup::{ModelKind, RunSetup, RunSpec, SceneRoles};
 use crate::{Error, Result};
 
@@ -107,7 +107,8 @@ pub fn run_block_setup(setup: &RunSetup) -> Result<BlockOutcome> {
     Ok(BlockOutcome { summary, run })
 }
 
-/// Another slip history drawn over a run's in its figure.
+/// Another run's history drawn over a run's in its figure (its slip, and for two-block
+/// runs its roof drift).
 #[derive(Debug, Clone)]
 pub struct SlipOverlay {
     /// Legend label.
@@ -120,13 +121,18 @@ pub struct SlipOverlay {
 }
 
 /// The overlays a teacher wants on a block run's figure: the exact block of the same
-/// inputs (for a DDA run), and the exact block without the vertical shaking (when there
-/// is some), so that its effect shows. Each takes milliseconds.
+/// inputs (for a DDA run), the exact block without the vertical shaking (when there is
+/// some), so that its effect shows, and on a friction pendulum's dish the exact block on
+/// a flat joint of the same friction, so that the dish's recentring shows. Each takes
+/// milliseconds.
 pub fn standard_overlays(setup: &RunSetup) -> Result<Vec<SlipOverlay>> {
     let mut overlays = Vec::new();
     if setup.model == ModelKind::Dda {
         overlays.push(SlipOverlay {
-            label: "exact rigid block".into(),
+            label: match setup.dish_radius() {
+                Some(r) => format!("exact point mass on the circle R = {r} m"),
+                None => "exact rigid block".into(),
+            },
             run: run_exact_block(setup, setup.dt)?,
             markers: true,
         });
@@ -139,6 +145,13 @@ pub fn standard_overlays(setup: &RunSetup) -> Result<Vec<SlipOverlay>> {
         overlays.push(SlipOverlay {
             label: "exact, without vertical shaking".into(),
             run: run_exact_block(&horizontal_only, setup.dt)?,
+            markers: false,
+        });
+    }
+    if setup.dish_radius().is_some() {
+        overlays.push(SlipOverlay {
+            label: "exact, on a flat joint".into(),
+            run: run_exact_block_on(setup, Surface::Flat, setup.dt)?,
             markers: false,
         });
     }
@@ -158,7 +171,11 @@ pub fn write_outputs(
     outcome.run.history.write_csv(&staged.path("history.csv"))?;
     staged.write_json("summary.json", &outcome.summary)?;
     if !outcome.run.history.is_empty() {
-        history_figure(outcome, overlays).save_png(&staged.path("history.png"), 1400, 900)?;
+        history_figure(setup, outcome, overlays).save_png(
+            &staged.path("history.png"),
+            1400,
+            900,
+        )?;
     }
     if let Some(fig) = super::friction_figure::friction_figure(setup, outcome, overlays) {
         fig.save_png(&staged.path("friction.png"), 1200, 900)?;
@@ -167,7 +184,7 @@ pub fn write_outputs(
 }
 
 /// The block's acceleration against the ground's, and its slip (with the overlays').
-fn history_figure(outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
+fn history_figure(setup: &RunSetup, outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
     let s = &outcome.summary;
     let column = |h: &History, name: &str| h.column(name).map(<[f64]>::to_vec).unwrap_or_default();
     let h = &outcome.run.history;
@@ -182,9 +199,13 @@ fn history_figure(outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
         .vertical_record
         .as_ref()
         .map_or(String::new(), |v| format!(" + vertical {v}"));
+    let what = match setup.dish_radius() {
+        Some(r) => format!("friction pendulum (R = {r} m)"),
+        None => "sliding block".into(),
+    };
     let mut fig = Figure::new(
         format!(
-            "sliding block ({}), friction {law}, {}{vertical}",
+            "{what} ({}), friction {law}, {}{vertical}",
             s.model, s.record
         ),
         2,
@@ -219,10 +240,18 @@ fn history_figure(outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
     p.y_label = "slip (m)".into();
     p.series
         .push(Series::line(s.model.clone(), t, column(h, "slip_m"), 2));
+    draw_overlays(p, overlays, "slip_m");
+    fig
+}
+
+/// Draws the overlays' column `name` against their time on panel `p`: the first in one
+/// colour, the others in another; references as markers.
+pub fn draw_overlays(p: &mut Panel, overlays: &[SlipOverlay], name: &str) {
+    let column = |h: &History, name: &str| h.column(name).map(<[f64]>::to_vec).unwrap_or_default();
     for (k, o) in overlays.iter().enumerate() {
         let (ot, os) = (
             column(&o.run.history, "time_s"),
-            column(&o.run.history, "slip_m"),
+            column(&o.run.history, name),
         );
         let color = if k == 0 { 0 } else { 4 };
         p.series.push(if o.markers {
@@ -234,16 +263,24 @@ fn history_figure(outcome: &BlockOutcome, overlays: &[SlipOverlay]) -> Figure {
             Series::line(o.label.clone(), ot, os, color)
         });
     }
-    fig
 }
 
 /// The exact rigid block of a sliding-block setup, as a run (output every `output_dt`
 /// seconds, none if ≤ 0). Energies per unit mass are scaled by the DDA block's mass.
 pub fn run_exact_block(setup: &RunSetup, output_dt: f64) -> Result<ModelRun> {
+    run_exact_block_on(setup, setup.sliding_block().surface, output_dt)
+}
+
+/// [`run_exact_block`] with the block on `surface` instead of the scene's.
+fn run_exact_block_on(setup: &RunSetup, surface: Surface, output_dt: f64) -> Result<ModelRun> {
     let start = Instant::now();
     let output_dt = simulate::exact_output_dt(output_dt, setup.duration);
     let options = SteppedOptions::default();
-    let r = simulate_block(&setup.sliding_block(), setup.duration, output_dt, &options)?;
+    let block = SlidingBlock {
+        surface,
+        ..setup.sliding_block()
+    };
+    let r = simulate_block(&block, setup.duration, output_dt, &options)?;
     let mass = setup.scene.block_mass(&setup.base)?;
     Ok(simulate::stepped_model_run(
         &r,

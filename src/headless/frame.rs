@@ -37,6 +37,9 @@ pub struct FrameSummary {
     /// The vertical ground motion (record name), when the ground also shakes vertically.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vertical_record: Option<String>,
+    /// Structural damping ratio ζ (`--damping`), when the structure is damped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
     /// The bearing under the base slab, `pendulum:R`, when it is not the flat joint.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bearing: Option<String>,
@@ -174,6 +177,7 @@ fn summarise(
         integrator: (model == ModelKind::Dda).then(|| setup.integrator.label()),
         record: setup.motion.label(),
         vertical_record: setup.vertical.as_ref().map(|v| v.label()),
+        damping: (setup.damping_ratio > 0.0).then_some(setup.damping_ratio),
         bearing: setup.bearing_radius.map(|r| format!("pendulum:{r}")),
         friction: super::run::reported_friction(setup, &mut warnings),
         fixed_base: setup.fixed_base,

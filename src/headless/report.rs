@@ -360,10 +360,13 @@ pub fn summary_markdown(
     w(&mut s, "|---|---:|---:|---:|---:|".into());
     let row = |s: &mut String, name: &str, a: f64, b: f64, c: f64, p: &str| {
         let f = |v: f64| {
-            if v.is_finite() {
-                format!("{v:.4}")
-            } else {
+            if !v.is_finite() {
                 "–".into()
+            } else if v != 0.0 && v.abs() < 1e-3 {
+                // Energy residuals of 1e-8: four decimals would print them as 0.
+                format!("{v:.1e}")
+            } else {
+                format!("{v:.4}")
             }
         };
         let _ = writeln!(s, "| {name} | {} | {} | {} | {p} |", f(a), f(b), f(c));

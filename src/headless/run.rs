@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::block::{SlipOverlay, draw_overlays};
 use super::simulate::{self, ModelRun};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::output::Staged;
@@ -37,6 +38,9 @@ pub struct RunSummary {
     /// The vertical ground motion (record name), when the ground also shakes vertically.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vertical_record: Option<String>,
+    /// Structural damping ratio ζ (`--damping`), when the structure is damped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
     /// Peak ground acceleration, g.
     pub amplitude_g: f64,
     /// Duration, s.
@@ -140,6 +144,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         freq_ratio,
         excitation: setup.excitation_label.clone(),
         vertical_record: setup.vertical.as_ref().map(|v| v.label()),
+        damping: (setup.damping_ratio > 0.0).then_some(setup.damping_ratio),
         amplitude_g: a_max / STANDARD_GRAVITY,
         duration_s: duration,
         dt_s: (!exact).then_some(setup.dt),
@@ -207,19 +212,51 @@ pub fn check_finite<T: Serialize>(summary: &T, end_time: f64) -> Result<()> {
 pub const OUTPUT_HISTORY: crate::setup::HistoryPlan =
     crate::setup::HistoryPlan::EverySteps(defaults::TWO_BLOCK_HISTORY_EVERY);
 
-/// Writes a run's histories and summary into `dir`.
-pub fn write_outputs(outcome: &RunOutcome, dir: &Path) -> Result<Vec<PathBuf>> {
+/// The overlays a teacher wants on a two-block run's figure: the exact model of the same
+/// inputs (for a DDA run), and when the structure is damped the exact model without the
+/// damping, so that its effect shows. Each takes milliseconds.
+pub fn standard_overlays(setup: &RunSetup) -> Result<Vec<SlipOverlay>> {
+    let output_dt = setup.dt * OUTPUT_HISTORY.stride() as f64;
+    let mut overlays = Vec::new();
+    if setup.model == ModelKind::Dda {
+        overlays.push(SlipOverlay {
+            label: "exact".into(),
+            run: simulate::run_exact_two_block(setup, output_dt)?,
+            markers: true,
+        });
+    }
+    if setup.damping_ratio > 0.0 {
+        let undamped = RunSetup {
+            damping_ratio: 0.0,
+            ..setup.clone()
+        };
+        overlays.push(SlipOverlay {
+            label: "exact, undamped".into(),
+            run: simulate::run_exact_two_block(&undamped, output_dt)?,
+            markers: false,
+        });
+    }
+    Ok(overlays)
+}
+
+/// Writes a run's histories and summary into `dir`; its figure draws `overlays` over the
+/// run's slip and roof drift.
+pub fn write_outputs(
+    outcome: &RunOutcome,
+    overlays: &[SlipOverlay],
+    dir: &Path,
+) -> Result<Vec<PathBuf>> {
     let mut staged = Staged::new(dir)?;
     outcome.run.history.write_csv(&staged.path("history.csv"))?;
     staged.write_json("summary.json", &outcome.summary)?;
     if !outcome.run.history.is_empty() {
-        history_figure(outcome).save_png(&staged.path("history.png"), 1400, 900)?;
+        history_figure(outcome, overlays).save_png(&staged.path("history.png"), 1400, 900)?;
     }
     staged.commit()
 }
 
-/// Time histories of a run: accelerations, slip and roof drift.
-fn history_figure(outcome: &RunOutcome) -> crate::post::plot::Figure {
+/// Time histories of a run: accelerations, slip and roof drift (with the overlays').
+fn history_figure(outcome: &RunOutcome, overlays: &[SlipOverlay]) -> crate::post::plot::Figure {
     use crate::post::plot::{Figure, Series};
     let h = &outcome.run.history;
     let s = &outcome.summary;
@@ -268,15 +305,22 @@ fn history_figure(outcome: &RunOutcome) -> crate::post::plot::Figure {
         g(col("roof_accel_m_s2")),
         0,
     ));
+    let damped = s
+        .damping
+        .map_or(String::new(), |z| format!(", damping ζ = {z}"));
     let p = &mut fig.panels[2];
-    p.title = format!("slip of the base u_s (peak {:.3e} m)", s.us_max_m);
+    p.title = format!("slip of the base u_s (peak {:.3e} m){damped}", s.us_max_m);
     p.x_label = "t (s)".into();
     p.y_label = "u_s (m)".into();
-    p.series.push(Series::line("", t.clone(), col("slip_m"), 2));
+    p.series
+        .push(Series::line(s.model.clone(), t.clone(), col("slip_m"), 2));
+    draw_overlays(p, overlays, "slip_m");
     let p = &mut fig.panels[3];
-    p.title = format!("roof drift u_r (peak {:.3e} m)", s.ur_max_m);
+    p.title = format!("roof drift u_r (peak {:.3e} m){damped}", s.ur_max_m);
     p.x_label = "t (s)".into();
     p.y_label = "u_r (m)".into();
-    p.series.push(Series::line("", t, col("roof_drift_m"), 3));
+    p.series
+        .push(Series::line(s.model.clone(), t, col("roof_drift_m"), 3));
+    draw_overlays(p, overlays, "roof_drift_m");
     fig
 }

@@ -65,8 +65,10 @@ pub trait FrictionLaw {
     /// sign), per unit normal force; finite.
     fn sliding_coefficient(&self, slip_speed: f64) -> f64;
 
-    /// Whether the sliding coefficient changes with the slip speed (the open-close
-    /// iteration then also waits for it to settle).
+    /// Whether the sliding coefficient changes with the slip speed: a sliding contact then
+    /// keeps the coefficient its step was solved with, so that the next step starts from
+    /// the force this one applied and booked (the open-close iteration waits for the
+    /// coefficient to settle for every law).
     fn depends_on_speed(&self) -> bool;
 }
 

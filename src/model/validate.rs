@@ -416,8 +416,14 @@ fn check_arc(vertices: &[Point], arc: &ArcDef) -> std::result::Result<(), String
         let off = off[0].hypot(off[1]) - arc.radius;
         if off.abs() > tolerance {
             return Err(format!(
-                "vertex {k} ({}, {}) is {off:.3e} m off the circle of radius {} about ({}, {});                  an arc's edges must be chords of its circle (to 1e-6 of the radius)",
-                p[0], p[1], arc.radius, arc.center[0], arc.center[1]
+                "vertex {} ({}, {}) is {off:.3e} m off the circle of radius {} about ({}, {}); \
+                 an arc's edges must be chords of its circle (to 1e-6 of the radius)",
+                k % n,
+                p[0],
+                p[1],
+                arc.radius,
+                arc.center[0],
+                arc.center[1]
             ));
         }
     }
@@ -428,7 +434,8 @@ fn check_arc(vertices: &[Point], arc: &ArcDef) -> std::result::Result<(), String
         // Counter-clockwise polygon: the outside is to the right of an edge.
         if geometry::cross(edge, to_centre) >= 0.0 {
             return Err(format!(
-                "the circle's centre is inside the block from edge {k}: an arc must be a                  dish (its centre on the free side of every chord)"
+                "the circle's centre is inside the block from edge {k}: an arc must be a \
+                 dish (its centre on the free side of every chord)"
             ));
         }
     }

@@ -671,8 +671,8 @@ impl Dda {
     /// lose its weight for a step at every facet it crossed.)
     fn add_contact_forces(&self, out: &mut [Vec6]) {
         for c in &self.contacts {
-            let edges = self.blocks[c.key.edge_block].vertices.len();
-            let Some(m) = contact::remembered(&self.memory, c.key, edges) else {
+            let Some(m) = contact::remembered(&self.memory, c.key, &self.blocks[c.key.edge_block])
+            else {
                 continue;
             };
             if !m.state.is_closed() {
@@ -752,8 +752,7 @@ impl Dda {
         self.spare_contacts
             .iter()
             .filter_map(|c| {
-                let edges = self.blocks[c.key.edge_block].vertices.len();
-                let m = contact::remembered(&self.memory, c.key, edges)?;
+                let m = contact::remembered(&self.memory, c.key, &self.blocks[c.key.edge_block])?;
                 m.state
                     .is_closed()
                     .then_some(m.normal_force * (c.gap0 - m.gap))
