@@ -11,7 +11,7 @@ use std::sync::Arc;
 use nalgebra::DVector;
 
 use super::block::{Mat6, Vec6, t_transpose_at};
-use super::joints::ElementTerms;
+use super::joints::{ElementTerms, MAX_NODES};
 use super::linear::{BlockMatrix, BlockPattern};
 use crate::model::geometry::{self, Point};
 
@@ -155,13 +155,13 @@ impl System {
         let dim = 2 * n;
         let c = self.stiffness_factor;
         // Node offsets from their blocks' centroids: Tᵀ·v is formed from them directly.
-        let mut offsets = [[0.0; 2]; 3];
+        let mut offsets = [[0.0; 2]; MAX_NODES];
         for (o, &(b, x)) in offsets.iter_mut().zip(nodes) {
             *o = geometry::sub(x, centroids[b]);
         }
         // The distinct blocks of the nodes, and which of them carries each node.
-        let mut blocks = [0usize; 3];
-        let mut group = [0usize; 3];
+        let mut blocks = [0usize; MAX_NODES];
+        let mut group = [0usize; MAX_NODES];
         let mut count = 0;
         for (k, &(b, _)) in nodes.iter().enumerate() {
             group[k] = match blocks[..count].iter().position(|&q| q == b) {
@@ -175,7 +175,7 @@ impl System {
         }
         // s[k][g][r] = row r of Σ over the nodes l on block g of ke_kl T_l (2×6), i.e.
         // Σ_l T_lᵀ (ke[2k+r][2l], ke[2k+r][2l+1]).
-        let mut s = [[[[0.0; 6]; 2]; 3]; 3];
+        let mut s = [[[[0.0; 6]; 2]; MAX_NODES]; MAX_NODES];
         for k in 0..n {
             for l in 0..n {
                 let skg = &mut s[k][group[l]];

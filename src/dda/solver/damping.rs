@@ -219,8 +219,12 @@ impl Dda {
 
 /// The velocities (or displacements) of an element's nodes, flattened (x₁, y₁, x₂, …),
 /// from their blocks' generalised velocities.
-fn node_velocities(terms: &ElementTerms, centroids: &[Point], per_block: &[Vec6]) -> [f64; 6] {
-    let mut out = [0.0; 6];
+fn node_velocities(
+    terms: &ElementTerms,
+    centroids: &[Point],
+    per_block: &[Vec6],
+) -> [f64; 2 * MAX_NODES] {
+    let mut out = [0.0; 2 * MAX_NODES];
     for (k, &(b, x)) in terms.nodes().iter().enumerate() {
         let v = point_displacement(centroids[b], x, &per_block[b]);
         out[2 * k] = v[0];

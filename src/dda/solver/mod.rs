@@ -23,7 +23,9 @@ use super::contact::{
     self, Contact, ContactMemories, ContactMemory, ContactPair, JointProps, dot6,
 };
 use super::energy::EnergyTerms;
-use super::joints::{Bolt, Connection, ElementTerms, FixedPoint, NodeMotion};
+use super::joints::{
+    Bolt, Connection, ConnectionGroups, ElementTerms, FixedPoint, MAX_NODES, NodeMotion,
+};
 use super::judge::{ContactState, JudgeInput, judge};
 use super::linear::{BlockPattern, LinearSolver, SolveError, TINY_LIMIT};
 use super::params::{AlphaCoefficients, SolverParams};
@@ -185,6 +187,8 @@ pub struct Dda {
     bolts: Vec<Bolt>,
     fixed: Vec<FixedPoint>,
     connections: Vec<Connection>,
+    /// Which connection triangles are assembled together (found once from the scene).
+    connection_groups: ConnectionGroups,
     loads: Vec<PointLoad>,
     motion: Option<GroundMotion>,
     /// The vertical ground motion (up positive), if the ground also shakes vertically.
@@ -442,6 +446,7 @@ impl Dda {
             memory: ContactMemories::default(),
             bolts,
             fixed,
+            connection_groups: ConnectionGroups::new(&connections),
             connections,
             loads,
             motion,

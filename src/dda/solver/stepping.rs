@@ -623,7 +623,7 @@ impl Dda {
                 // The terms were computed at this geometry: their force is the start force.
                 None => e.start_forces(),
                 Some(d) => {
-                    let mut u = [[0.0; 2]; 3];
+                    let mut u = [[0.0; 2]; MAX_NODES];
                     for (uk, &(b, x)) in u.iter_mut().zip(nodes) {
                         *uk = point_displacement(centroids[b], x, &d[b]);
                     }

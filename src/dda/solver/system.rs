@@ -14,7 +14,8 @@ impl Dda {
         out.clear();
         out.extend(self.bolts.iter().map(Bolt::terms));
         out.extend(self.fixed.iter().map(FixedPoint::terms));
-        out.extend(self.connections.iter().map(Connection::terms));
+        // A connection's triangles share their nodes: merged, each gap is one element.
+        self.connection_groups.terms_into(&self.connections, out);
     }
 
     /// Makes `self.elements` the terms of the joints as they are now (computing them only
