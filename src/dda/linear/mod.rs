@@ -390,7 +390,12 @@ const ENVELOPE_LIMIT: usize = 120;
 /// the envelope counts, or ~nnz(L)²/n for a sparse factor.
 fn iteration_budget(factorisation: f64, factor_nonzeros: usize, matrix_nonzeros: usize) -> usize {
     let (l, a) = (factor_nonzeros as f64, matrix_nonzeros as f64);
-    (factorisation / (4.0 * l + 2.0 * a)).floor() as usize
+    let budget = (factorisation / (4.0 * l + 2.0 * a)).floor() as usize;
+    // Before its first iteration an attempt applies the kept factor and forms a residual,
+    // about one iteration's work: with a budget of one, a failed attempt costs twice a
+    // factorisation's worth before the factorisation it then needs anyway (the frame's
+    // step did exactly that, every step). Such a factor is renewed at every change.
+    if budget < 2 { 0 } else { budget }
 }
 
 /// Backward error ‖R − K D‖ / (‖K‖‖D‖ + ‖R‖) accepted from the iteration: ~50 ε, what a
