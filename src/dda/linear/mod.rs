@@ -510,6 +510,8 @@ struct Slot {
     spent: usize,
     /// When it was last used (the solver's solve count).
     used: u64,
+    /// The matrix the factor was made of, block by block.
+    matrix: Vec<Mat6>,
 }
 
 impl Slot {
@@ -519,7 +521,22 @@ impl Slot {
             factored: None,
             spent: 0,
             used: 0,
+            matrix: Vec::new(),
         }
+    }
+
+    /// Whether the factor is of this very matrix, to the bit (a factorisation of it again
+    /// would give the same factor). Not kept for a tiny factor, which costs less to make
+    /// again than to check.
+    fn holds(&self, k: &BlockMatrix) -> bool {
+        !matches!(self.factor, Factor::Tiny(_))
+            && self.matrix.len() == k.blocks.len()
+            && self.matrix.iter().zip(&k.blocks).all(|(a, b)| {
+                a.iter()
+                    .flatten()
+                    .zip(b.iter().flatten())
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+            })
     }
 }
 
@@ -717,6 +734,14 @@ impl LinearSolver {
         if let Some(i) = kept {
             self.active = i;
             self.slots[i].used = self.stats.solves;
+            // The same matrix solved again (the event projection's multiplier updates,
+            // the two-block's repeated solves): its factor is the factorisation's result.
+            if self.slots[i].holds(k) {
+                self.fresh = true;
+                x.copy_from_slice(rhs);
+                self.apply_inverse(x);
+                return Ok(());
+            }
             if self.slots[i].spent < self.budget && self.iterate(k, rhs, x) {
                 self.fresh = false;
                 return Ok(());
@@ -737,6 +762,9 @@ impl LinearSolver {
         let slot = &mut self.slots[self.active];
         slot.factored = Some(structure);
         slot.used = self.stats.solves;
+        if !matches!(slot.factor, Factor::Tiny(_)) {
+            slot.matrix.clone_from(&k.blocks);
+        }
         self.fresh = true;
         x.copy_from_slice(rhs);
         self.apply_inverse(x);
@@ -993,6 +1021,32 @@ mod tests {
         // A new key factorises again.
         solver.solve(&k2, &rhs, 2, &mut x2).unwrap();
         assert_eq!(solver.stats().factorizations, 3 - kept as u64);
+    }
+
+    /// The very matrix solved again (another right-hand side) takes the kept factor as
+    /// it is, with no new factorisation and the solution a new factorisation would give,
+    /// to the bit; a matrix that differs in one entry does not.
+    #[test]
+    fn the_same_matrix_again_reuses_its_factor() {
+        for blocks in [8, 40] {
+            let k = chain(blocks, 7);
+            let n = k.unknowns();
+            let mut solver = LinearSolver::new(Arc::clone(k.pattern())).unwrap();
+            let mut fresh = LinearSolver::new(Arc::clone(k.pattern())).unwrap();
+            let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
+            let first: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let second: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
+            solver.solve(&k, &first, 1, &mut x).unwrap();
+            solver.solve(&k, &second, 1, &mut x).unwrap();
+            assert_eq!(solver.stats().factorizations, 1, "{blocks} blocks");
+            fresh.solve(&k, &second, 1, &mut y).unwrap();
+            assert!(x.iter().zip(&y).all(|(a, b)| a.to_bits() == b.to_bits()));
+            let mut changed = k.clone();
+            let mut bump = [[0.0; 6]; 6];
+            bump[3][3] = 1.0;
+            changed.add(blocks - 1, blocks - 1, &bump, 1.0);
+            assert!(!solver.slots[solver.active].holds(&changed));
+        }
     }
 
     #[test]
