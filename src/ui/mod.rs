@@ -677,7 +677,9 @@ impl AppState {
         for f in &self.timeline.frames[scanned..] {
             for model in &f.models {
                 for b in model.blocks.iter().filter(|b| !b.is_ground) {
-                    m = m.max(crate::render::geometry::color_measure(by, &b.stress, &b.strain));
+                    m = m.max(crate::render::geometry::color_measure(
+                        by, &b.stress, &b.strain,
+                    ));
                 }
             }
         }
