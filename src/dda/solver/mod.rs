@@ -785,14 +785,6 @@ impl Dda {
         }
     }
 
-    /// Whether the current scheme has no numerical dissipation (αm = αf, γ = ½: the
-    /// trapezoidal rule, HHT α = 0, generalised-α ρ∞ = 1), so that nothing damps an
-    /// impulse left in the end acceleration.
-    fn is_non_dissipative(&self) -> bool {
-        let c = self.coeffs;
-        c.alpha_m == c.alpha_f && c.gamma == 0.5
-    }
-
     fn augmented(&self) -> bool {
         self.params.contact_enforcement == super::params::ContactEnforcement::AugmentedLagrangian
     }

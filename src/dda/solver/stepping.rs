@@ -307,20 +307,6 @@ impl Dda {
                             .contacts
                             .iter()
                             .any(|c| c.start_state.is_closed() && c.state == ContactState::Open);
-                        // A contact that closed inside the step without a landing on it
-                        // (one landing per nominal step) was stopped by its constraint with
-                        // an impulsive force, which the end acceleration carries. A scheme
-                        // without numerical dissipation would apply it again in the next
-                        // step (half of it, if the contact opens: +57 kJ in one step for a
-                        // block toppling at 0.7 g). So the motion is projected onto the new
-                        // contact states, as at a landed event: the approach velocity is
-                        // taken out (a plastic impact, booked as the impact's loss) and the
-                        // accelerations balance the forces without the impulse.
-                        let closed = self.augmented()
-                            && self.is_non_dissipative()
-                            && self.contacts.iter().any(|c| {
-                                c.start_state == ContactState::Open && c.state.is_closed()
-                            });
                         if self.augmented() && dt_override.is_some() {
                             for (key, state) in std::mem::take(&mut self.pending_events) {
                                 if let Some(m) = self.memory.get_mut(&key)
@@ -335,14 +321,8 @@ impl Dda {
                                 }
                             }
                         }
-                        let project = closed && dt_override.is_none() && !opened;
-                        if project {
-                            self.resolve_event()?;
-                        }
                         self.restart = match (dt_override.is_some(), restart) {
                             (true, _) => event_kind,
-                            // Projected already.
-                            (false, _) if project => Restart::None,
                             (false, Restart::Impact) => Restart::AfterImpact,
                             (false, _) if opened => Restart::Event,
                             (false, _) => Restart::None,
@@ -460,10 +440,6 @@ impl Dda {
         // Friction and contact counts.
         let augmented = self.augmented();
         let mut dissipated = 0.0;
-        // A contact that enters the step closed without a force (its closing was landed
-        // on, to within the landing's interpolation) may still have a gap, which its
-        // constraint closes: that force's work is a plastic impact's.
-        let mut closing = 0.0;
         let mut max_pen = 0.0_f64;
         let (mut closed, mut sliding) = (0, 0);
         for ct in &self.contacts {
@@ -474,9 +450,6 @@ impl Dda {
             if ct.state.is_closed() {
                 closed += 1;
                 max_pen = max_pen.max(-gap);
-                if augmented && ct.start_state.is_closed() && ct.start_normal == 0.0 {
-                    closing += 0.5 * ct.normal_multiplier * (ct.gap0 - gap);
-                }
             }
             if let ContactState::Sliding { direction } = ct.state {
                 sliding += 1;
@@ -573,7 +546,6 @@ impl Dda {
             e.numerical_dissipated += numerical;
         }
         e.numerical_dissipated += drift;
-        e.impact_dissipated += closing;
         let kinetic = self.kinetic_energy();
         let strain = self.stored_energy() - self.stored_reference;
         self.energy.kinetic = kinetic;
