@@ -525,11 +525,23 @@ impl Slot {
         }
     }
 
-    /// Whether the factor is of this very matrix, to the bit (a factorisation of it again
-    /// would give the same factor). Not kept for a tiny factor, which costs less to make
-    /// again than to check.
-    fn holds(&self, k: &BlockMatrix) -> bool {
+    /// Whether the factor keeps a copy of the matrix it was made of: not a tiny factor,
+    /// which costs less to make again than to check.
+    fn keeps_matrix(&self) -> bool {
         !matches!(self.factor, Factor::Tiny(_))
+    }
+
+    /// Records `k` as the matrix the factor was just made of (if it keeps one).
+    fn remember(&mut self, k: &BlockMatrix) {
+        if self.keeps_matrix() {
+            self.matrix.clone_from(&k.blocks);
+        }
+    }
+
+    /// Whether the factor is of this very matrix, to the bit (a factorisation of it again
+    /// would give the same factor).
+    fn holds(&self, k: &BlockMatrix) -> bool {
+        self.keeps_matrix()
             && self.matrix.len() == k.blocks.len()
             && self.matrix.iter().zip(&k.blocks).all(|(a, b)| {
                 a.iter()
@@ -762,9 +774,7 @@ impl LinearSolver {
         let slot = &mut self.slots[self.active];
         slot.factored = Some(structure);
         slot.used = self.stats.solves;
-        if !matches!(slot.factor, Factor::Tiny(_)) {
-            slot.matrix.clone_from(&k.blocks);
-        }
+        slot.remember(k);
         self.fresh = true;
         x.copy_from_slice(rhs);
         self.apply_inverse(x);
