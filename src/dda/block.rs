@@ -71,7 +71,7 @@ pub fn point_displacement(c: Point, p: Point, d: &Vec6) -> Point {
 /// `det(exp(ΔE)) = exp(εx + εy)`, so the area follows the accumulated volumetric strain
 /// (to third order per step) whatever path it took. The departure from the linear
 /// motion the step was solved with is second order, as the rotation's is, and the
-/// contacts book it the same way (see `Dda::constraint_drift_work`).
+/// contacts book it the same way (the constraint work in `Dda::commit_step`).
 ///
 /// The classic update is the paper's linear map `T·D`: R = I + r0·J and S = ΔE.
 #[derive(Debug, Clone, Copy, PartialEq)]

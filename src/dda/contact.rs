@@ -74,7 +74,7 @@ pub struct ContactMemory {
     /// How much the shear multiplier changed over the last step (while locked), N.
     pub shear_change: f64,
     /// Gap at the end of the last step as that step's linear motion put it, m (the
-    /// geometry update departs from it: see `Dda::constraint_drift_work`).
+    /// geometry update departs from it, and the next step's constraint work closes it).
     pub gap: f64,
 }
 

@@ -29,8 +29,9 @@ pub struct EnergyTerms {
     pub impact_dissipated: f64,
     /// What the time integrator dissipated (positive) or created (negative), computed
     /// from its own states (see `Dda::commit_step`; zero for the trapezoidal rule), and
-    /// what the exact constraints took back from the geometry update's departure from
-    /// the linear step (see `Dda::constraint_drift_work`).
+    /// the work of the exact constraints on the gaps they close (the geometry update's
+    /// departure from the linear step, a landing's leftover gap, the augmented
+    /// Lagrangian's penetration; see `Dda::commit_step`).
     pub numerical_dissipated: f64,
 }
 
