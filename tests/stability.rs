@@ -91,3 +91,54 @@ stability_tests! {
 fn long_run_energy_does_not_drift() {
     assert_case("1000 s run");
 }
+
+/// The overturning case over a grid (9 amplitudes 0.45–1 g × Δt 1, 0.8, 0.7, 0.5 ms, the
+/// trapezoidal rule and the default integrator: 72 runs of 4 s): energy cannot be made
+/// by the model, so no run may end with a negative energy residual beyond the ledger's
+/// accuracy over impacts, and every toppled block must lie on its side. Before the
+/// landing of every fresh impact, the classic step for contacts that open and the
+/// consistent friction forces, 14 trapezoidal runs gained more than 1 % (worst 88 %: the
+/// block was thrown into a spin of five turns). The bound is 2 % of the energy through
+/// the run (today's worst gain is 1.1 %); at most one run may stop, with the solver's
+/// error (1 g at Δt 1 ms with the trapezoidal rule: an open-close iteration that does not
+/// settle, see docs/stability.md).
+#[test]
+#[ignore = "slow in a debug build: run with --release -- --ignored"]
+fn a_toppling_block_gains_no_energy() {
+    use slidebase::dda::{Dda, Integrator, SolverParams};
+    use slidebase::ground_motion::{GroundMotion, Harmonic};
+    use slidebase::headless::stability::single_block_scene;
+    let mut stopped = Vec::new();
+    for integrator in [
+        Integrator::Trapezoidal,
+        Integrator::GeneralizedAlpha { rho_inf: 0.0 },
+    ] {
+        for amplitude in [0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 1.0] {
+            for dt in [1e-3, 0.8e-3, 0.7e-3, 0.5e-3] {
+                let scene = single_block_scene(0.1, 1.0, 0.0, 0.0, 0.8).unwrap();
+                let motion = GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude, 0.5).unwrap());
+                let params = SolverParams {
+                    duration: 4.0,
+                    dt,
+                    integrator,
+                    ..SolverParams::default()
+                };
+                let mut dda = Dda::new(&scene, Some(motion), params).unwrap();
+                let run = format!("{} at {amplitude} g, Δt {dt:e}", integrator.label());
+                if let Err(e) = dda.run_until(4.0, |_, _| {}) {
+                    stopped.push(format!("{run}: {e}"));
+                    continue;
+                }
+                let residual = dda.energy_residual_relative();
+                assert!(residual > -2e-2, "{run}: energy residual {residual:+.3e}");
+                let block = &dda.blocks()[dda.block_index("block").unwrap()];
+                assert!(
+                    (block.rotation.abs() - std::f64::consts::FRAC_PI_2).abs() < 0.02,
+                    "{run}: rotation {:.4} rad, not on its side",
+                    block.rotation
+                );
+            }
+        }
+    }
+    assert!(stopped.len() <= 1, "runs stopped: {stopped:#?}");
+}

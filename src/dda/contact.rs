@@ -110,6 +110,10 @@ pub struct Contact {
     pub flips: u32,
     /// Normal force used for friction in the current pass, N.
     pub friction_normal: f64,
+    /// The normal force the previous pass used for friction and the one it found, N,
+    /// while the contact kept sliding (for the secant update of the open-close
+    /// iteration).
+    pub friction_trial: Option<(f64, f64)>,
     /// Sliding friction coefficient used in the current pass (the law's, at the end slip
     /// speed of the previous pass).
     pub sliding_coefficient: f64,
@@ -426,6 +430,7 @@ fn linearise(
         shear0,
         state: start_state,
         friction_normal: normal,
+        friction_trial: None,
         sliding_coefficient: props.friction.sliding_coefficient(start_slip_velocity),
         start_normal: normal,
         previous_normal_change: normal_change,

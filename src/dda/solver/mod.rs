@@ -211,6 +211,12 @@ pub struct Dda {
     restart: Restart,
     /// When the last step was landed on an event.
     last_landing: f64,
+    /// How many times the constraint penalties of the step being iterated exceed those
+    /// of a nominal step (see `Dda::stiffen_constraints_for`).
+    penalty_boost: f64,
+    /// The contacts whose impacts steps were landed on within the last nominal step, and
+    /// when (see `step_with_current_scheme`).
+    recent_impacts: Vec<(contact::ContactKey, f64)>,
     /// The states contacts take at the event a shortened step is landed on.
     pending_events: Vec<(contact::ContactKey, ContactState)>,
     /// The stored accelerations are not yet those of the forces (a model that starts
@@ -466,6 +472,8 @@ impl Dda {
             last: StepReport::default(),
             restart: Restart::None,
             last_landing: f64::NEG_INFINITY,
+            penalty_boost: 1.0,
+            recent_impacts: Vec::new(),
             pending_events: Vec::new(),
             initial_accel_pending: false,
         };
@@ -492,9 +500,33 @@ impl Dda {
             self.search_distance,
             &mut self.contacts,
         );
+        self.penalty_boost = 1.0;
         if self.augmented() {
             self.scale_constraint_penalties();
         }
+    }
+
+    /// Raises the constraint penalties of a step of `dt` shorter than the nominal one by
+    /// Δt_nominal/Δt. At the penalties of a nominal step, each multiplier update of a
+    /// step cut to 1e-8 s closed a millionth of the violation (the inertia the contacts
+    /// see grows as 1/Δt²), the updates ran out, and the normal force crept up by the
+    /// same amount in every open-close pass, which then never settled (a toppling
+    /// block's grazing corner; the cuts made it worse). Raised as 1/Δt, an update still
+    /// closes a tenth of it there, while the multipliers' round-off (the penalty times
+    /// the gaps' round-off) stays as small against the step's forces (which grow as
+    /// 1/Δt) as in a nominal step: raised as 1/Δt², a bonded slider's contacts flipped on
+    /// that noise. The judge still weighs the multipliers against the nominal penalty,
+    /// so that a contact opens at the same tension.
+    pub(super) fn stiffen_constraints_for(&mut self, dt: f64) {
+        if !self.augmented() || dt >= self.params.dt {
+            return;
+        }
+        let boost = self.params.dt / dt;
+        for c in &mut self.contacts {
+            c.props.normal_penalty *= boost;
+            c.props.shear_penalty *= boost;
+        }
+        self.penalty_boost = boost;
     }
 
     /// With the augmented Lagrangian the penalties only set how fast the multipliers

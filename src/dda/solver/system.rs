@@ -178,7 +178,9 @@ impl Dda {
         if zeta == 0.0 || !c.state.is_closed() {
             return (0.0, 0.0);
         }
-        let crit = |p: f64| 2.0 * zeta * (p * c.damping_mass).sqrt();
+        // (At the penalties of a nominal step: a shortened step's stiffer constraints
+        // are an iteration device, not a stiffer contact.)
+        let crit = |p: f64| 2.0 * zeta * (p / self.penalty_boost * c.damping_mass).sqrt();
         let shear = if c.state == ContactState::Locked {
             crit(c.props.shear_penalty)
         } else {
