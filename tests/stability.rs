@@ -105,9 +105,8 @@ fn long_run_energy_does_not_drift() {
 #[test]
 #[ignore = "slow in a debug build: run with --release -- --ignored"]
 fn a_toppling_block_gains_no_energy() {
-    use slidebase::dda::{Dda, Integrator, SolverParams};
-    use slidebase::ground_motion::{GroundMotion, Harmonic};
-    use slidebase::headless::stability::single_block_scene;
+    use slidebase::dda::Integrator;
+    use slidebase::headless::stability::toppling_block_run;
     let mut stopped = Vec::new();
     for integrator in [
         Integrator::Trapezoidal,
@@ -115,20 +114,14 @@ fn a_toppling_block_gains_no_energy() {
     ] {
         for amplitude in [0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 1.0] {
             for dt in [1e-3, 0.8e-3, 0.7e-3, 0.5e-3] {
-                let scene = single_block_scene(0.1, 1.0, 0.0, 0.0, 0.8).unwrap();
-                let motion = GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude, 0.5).unwrap());
-                let params = SolverParams {
-                    duration: 4.0,
-                    dt,
-                    integrator,
-                    ..SolverParams::default()
-                };
-                let mut dda = Dda::new(&scene, Some(motion), params).unwrap();
                 let run = format!("{} at {amplitude} g, Δt {dt:e}", integrator.label());
-                if let Err(e) = dda.run_until(4.0, |_, _| {}) {
-                    stopped.push(format!("{run}: {e}"));
-                    continue;
-                }
+                let dda = match toppling_block_run(amplitude, dt, integrator) {
+                    Ok(dda) => dda,
+                    Err(e) => {
+                        stopped.push(format!("{run}: {e}"));
+                        continue;
+                    }
+                };
                 let residual = dda.energy_residual_relative();
                 assert!(residual > -2e-2, "{run}: energy residual {residual:+.3e}");
                 let block = &dda.blocks()[dda.block_index("block").unwrap()];

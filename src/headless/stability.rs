@@ -13,7 +13,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::simulate::{self, ModelRun};
-use crate::dda::{Dda, SolverParams};
+use crate::dda::{Dda, Integrator, SolverParams};
 use crate::ground_motion::{GroundMotion, Harmonic, STANDARD_GRAVITY};
 use crate::model::Scene;
 use crate::post::output::Staged;
@@ -640,6 +640,24 @@ fn free_rocking(case: &str) -> StabilityRow {
     }
 }
 
+/// The overturning run: a 0.2 m × 2 m block (μ 0.8) shaken at `amplitude_g`, 0.5 Hz, for
+/// 4 s, with step `dt` and `integrator`; the model as it ends. The stability case runs it
+/// at 0.5 g with the defaults, and `tests/stability.rs` over a grid of amplitudes, steps
+/// and integrators.
+pub fn toppling_block_run(amplitude_g: f64, dt: f64, integrator: Integrator) -> Result<Dda> {
+    let scene = single_block_scene(0.1, 1.0, 0.0, 0.0, 0.8)?;
+    let motion = GroundMotion::Harmonic(Harmonic::from_g_hz(amplitude_g, 0.5)?);
+    let params = SolverParams {
+        duration: 4.0,
+        dt,
+        integrator,
+        ..SolverParams::default()
+    };
+    let mut dda = Dda::new(&scene, Some(motion), params)?;
+    dda.run_until(4.0, |_, _| {})?;
+    Ok(dda)
+}
+
 /// A 0.2 m × 2 m block shaken at 0.5 g, 0.5 Hz: five times its uplift threshold, for
 /// long enough to overturn (the pulse lasts longer than the block's rocking time scale
 /// 1/p ≈ 0.4 s). It must fall onto its side and lie there, with the energy accounted for.
@@ -648,14 +666,8 @@ fn overturning(case: &str) -> StabilityRow {
                  |θ̇| < 1e-3 rad/s, |energy residual| < 1e-2, penetration < 1e-3 of the size";
     let start = Instant::now();
     let run = || -> Result<(Dda, f64, f64)> {
-        let scene = single_block_scene(0.1, 1.0, 0.0, 0.0, 0.8)?;
-        let motion = GroundMotion::Harmonic(Harmonic::from_g_hz(0.5, 0.5)?);
-        let params = SolverParams {
-            duration: 4.0,
-            ..SolverParams::default()
-        };
-        let mut dda = Dda::new(&scene, Some(motion), params)?;
-        dda.run_until(4.0, |_, _| {})?;
+        let defaults = SolverParams::default();
+        let dda = toppling_block_run(0.5, defaults.dt, defaults.integrator)?;
         let block = &dda.blocks()[dda.block_index("block")?];
         let (rotation, spin) = (block.rotation, block.velocity[2]);
         Ok((dda, rotation, spin))

@@ -23,6 +23,16 @@ impl Dda {
         result
     }
 
+    /// The gap by which a closed contact must open to open: one opening by less stays
+    /// closed (so that one resting at zero force does not flicker). Its spring then
+    /// pulls, by at most p·tolerance: 1e-12 of the size keeps that tension far below any
+    /// force of interest (0.3 mN per metre of size for p = 1e12 N/m; a tolerance of 1e-9
+    /// of the size let a 2 m block hang on 2 kN and held it down past its uplift
+    /// threshold), yet well above the rounding of the gap (1e-16 of the size).
+    pub(super) fn open_tolerance(&self) -> f64 {
+        1e-12 * self.structure_size
+    }
+
     /// The open-close passes of one step on its base system.
     pub(super) fn open_close(
         &mut self,
@@ -30,13 +40,7 @@ impl Dda {
         known: &[Vec6],
         base: &System,
     ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
-        // A closed contact whose gap opens by less than this stays closed (so that one
-        // resting at zero force does not flicker). Its spring then pulls, by at most
-        // p·tolerance: 1e-12 of the size keeps that tension far below any force of
-        // interest (0.3 mN per metre of size for p = 1e12 N/m; a tolerance of 1e-9 of
-        // the size let a 2 m block hang on 2 kN and held it down past its uplift
-        // threshold), yet well above the rounding of the gap (1e-16 of the size).
-        let open_tolerance = 1e-12 * self.structure_size;
+        let open_tolerance = self.open_tolerance();
         let slip_tolerance = 1e-12 * self.structure_size;
         let max_passes = self.params.max_open_close_passes;
         // Inline for the systems the linear solver factorises on the stack.

@@ -409,12 +409,11 @@ impl Dda {
         let Some(&(primary, _)) = pending.first() else {
             return;
         };
-        let open_tolerance = 1e-12 * self.structure_size;
         let reach = self
             .memory
             .get(&primary)
             .map_or(0.0, |m| 2.0 * m.gap.max(0.0))
-            + open_tolerance;
+            + self.open_tolerance();
         let augmented = self.augmented();
         for (key, state) in pending {
             let Some(m) = self.memory.get_mut(&key) else {
