@@ -52,8 +52,9 @@ pub struct JudgeInput {
     pub slip_velocity: f64,
     /// A bonded joint never opens or slides.
     pub bonded: bool,
-    /// A closed contact opens only when the gap exceeds this (small, > 0) value: a little
-    /// hysteresis so that a contact resting at zero force does not flicker.
+    /// A closed contact opens only when the gap exceeds this (small, > 0) value, and an
+    /// open one closes only when the gap is below its negative: a little hysteresis so
+    /// that a contact resting at zero force does not flicker.
     pub open_tolerance: f64,
     /// Slip reversals smaller than this (m) are not reversals: round-off, not physics.
     pub slip_tolerance: f64,
@@ -61,7 +62,10 @@ pub struct JudgeInput {
 
 /// Decides the state a contact should have, given a trial solution.
 ///
-/// - Open → Locked when the vertex penetrates (gap < 0).
+/// - Open → Locked when the vertex penetrates beyond the tolerance (gap < −tolerance:
+///   the same hysteresis as for opening, so that a vertex grazing at zero force settles
+///   open instead of flipping between a closed pass in tension and an open one a
+///   picometre deep — a toppling block's pivot corner did that down to any Δt).
 /// - Closed → Open when the gap opens beyond the tolerance (no tension in contacts).
 /// - Locked → Sliding when the shear spring force exceeds ρN, slipping the way the
 ///   spring was pulled.
@@ -74,7 +78,7 @@ pub fn judge(input: &JudgeInput) -> ContactState {
         return ContactState::Locked;
     }
     let closed = match input.state {
-        ContactState::Open => input.gap < 0.0,
+        ContactState::Open => input.gap < -input.open_tolerance,
         _ => input.gap <= input.open_tolerance,
     };
     if !closed {
@@ -151,12 +155,20 @@ mod tests {
                 Open,
             ),
             (
-                "open closes on penetration",
+                "open closes on penetration beyond the tolerance",
                 JudgeInput {
-                    gap: -1e-9,
+                    gap: -2e-9,
                     ..input(Open)
                 },
                 Locked,
+            ),
+            (
+                "open stays open within the tolerance",
+                JudgeInput {
+                    gap: -5e-10,
+                    ..input(Open)
+                },
+                Open,
             ),
             (
                 "open stays open at exactly zero gap",

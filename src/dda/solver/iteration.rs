@@ -185,7 +185,7 @@ impl Dda {
                     // spring throws it back out with energy it never had), the second
                     // holds it with a spring in tension. The step is cut instead.
                     contradicted |= match c.state {
-                        ContactState::Open => gap < 0.0,
+                        ContactState::Open => gap < -open_tolerance,
                         _ => judged_gap > open_tolerance,
                     };
                     continue;
