@@ -94,14 +94,18 @@ fn long_run_energy_does_not_drift() {
 
 /// The overturning case over a grid (9 amplitudes 0.45–1 g × Δt 1, 0.8, 0.7, 0.5 ms, the
 /// trapezoidal rule and the default integrator: 72 runs of 4 s): energy cannot be made
-/// by the model, so no run may end with a negative energy residual beyond the ledger's
-/// accuracy over impacts, and every toppled block must lie on its side. Before the
-/// landing of every fresh impact, the classic step for contacts that open and the
-/// consistent friction forces, 14 trapezoidal runs gained more than 1 % (worst 88 %: the
-/// block was thrown into a spin of five turns). The bound is 2 % of the energy through
-/// the run (today's worst gain is 1.1 %), and every run finishes (before an open contact
-/// closed at any penetration, a pivot corner grazing at zero force flipped between a
-/// closed pass in tension and an open one a picometre deep, and 1 g at Δt 1 ms stopped).
+/// by the model, and every term of the balance is booked, so each run's residual must be
+/// far below its smallest dissipation (friction, at least 1.2e-2 of the energy through
+/// the run; impacts 0.6–0.98): a missed term in any step of substance would show. Gains
+/// are bounded at 1e-5 with the trapezoidal rule (it creates no energy of its own) and
+/// 1e-4 with the default, losses at 1e-3. Before the landing of every fresh impact, the
+/// classic step for contacts that open and the consistent friction forces, 14
+/// trapezoidal runs gained more than 1 % (worst 88 %: the block was thrown into a spin
+/// of five turns); before the tangential force of contacts that open was booked (a
+/// corner sliding under 2e6 N lifting off within a step), the worst gain was 1.1 % and
+/// losses reached 4.5 %. Every run must finish (before an open contact closed at any
+/// penetration, a pivot corner grazing at zero force flipped between a closed pass in
+/// tension and an open one a picometre deep, and 1 g at Δt 1 ms stopped).
 #[test]
 #[ignore = "slow in a debug build: run with --release -- --ignored"]
 fn a_toppling_block_gains_no_energy() {
@@ -123,7 +127,14 @@ fn a_toppling_block_gains_no_energy() {
                     }
                 };
                 let residual = dda.energy_residual_relative();
-                assert!(residual > -2e-2, "{run}: energy residual {residual:+.3e}");
+                let largest_gain = match integrator {
+                    Integrator::Trapezoidal => 1e-5,
+                    _ => 1e-4,
+                };
+                assert!(
+                    (-largest_gain..1e-3).contains(&residual),
+                    "{run}: energy residual {residual:+.3e}"
+                );
                 let block = &dda.blocks()[dda.block_index("block").unwrap()];
                 assert!(
                     (block.rotation.abs() - std::f64::consts::FRAC_PI_2).abs() < 0.02,

@@ -29,7 +29,7 @@ pub struct EnergyTerms {
     pub impact_dissipated: f64,
     /// What the time integrator dissipated (positive) or created (negative), computed
     /// from its own states (see `Dda::commit_step`; zero for the trapezoidal rule), and
-    /// the work of the exact constraints on the gaps they close (the geometry update's
+    /// the work of the exact constraints on the gaps and slips they close (the geometry update's
     /// departure from the linear step, a landing's leftover gap, the augmented
     /// Lagrangian's penetration; see `Dda::commit_step`).
     pub numerical_dissipated: f64,
