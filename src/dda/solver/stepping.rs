@@ -543,21 +543,16 @@ impl Dda {
                 closed += 1;
                 max_pen = max_pen.max(-gap);
             }
-            if augmented && (ct.state.is_closed() || ct.start_state.is_closed()) {
-                // (A contact that opens ends the step with no force: its start force
-                // pushed the vertex off while the gap opened, as the scheme applies it.)
-                let end_normal = if ct.state.is_closed() {
-                    ct.normal_multiplier
-                } else {
-                    0.0
-                };
-                constraint_work += 0.5 * (ct.start_normal + end_normal) * (ct.gap0 - gap);
-            }
             if matches!(ct.state, ContactState::Sliding { .. }) {
                 sliding += 1;
             }
             if augmented && (ct.state.is_closed() || ct.start_state.is_closed()) {
-                let (friction, constraint, relabel) = tangential_work(ct, slip, impact);
+                // The forces the contact ends the step with (none if it opens: its start
+                // force pushed the vertex off while the gap opened, as the scheme applies
+                // it); the tangential one as a multiplier, the negative of the pull.
+                let (end_normal, end_pull) = self.contact_force(ct);
+                constraint_work += 0.5 * (ct.start_normal + end_normal) * (ct.gap0 - gap);
+                let (friction, constraint, relabel) = tangential_work(ct, -end_pull, slip, impact);
                 dissipated += friction;
                 constraint_work += constraint;
                 relabelled += relabel;
@@ -853,6 +848,7 @@ fn step_size(nominal: f64, max_dt: f64) -> f64 {
 
 /// The work of a closed (augmented-Lagrangian) contact's tangential force on its slip
 /// over a step, split as the ledger books it: `(friction, constraint, relabelled)`.
+/// `end_force`: the tangential multiplier it ends the step with.
 ///
 /// Like every force of the ledger, the force is the average of the step's two ends: the
 /// multiplier the contact started with and the one it ends with (the friction of a
@@ -866,14 +862,7 @@ fn step_size(nominal: f64, max_dt: f64) -> f64 {
 /// force only (its start force can be an impulse over 1e-7 s, whose average with the end
 /// over a full step booked 1.2 MJ of friction against 14 kJ of input): its friction is
 /// the end force's work and the rest of the average is relabelled as the impact's.
-fn tangential_work(ct: &Contact, slip: f64, impact: bool) -> (f64, f64, f64) {
-    let end_force = match ct.state {
-        ContactState::Open => 0.0,
-        ContactState::Locked => ct.shear_multiplier,
-        ContactState::Sliding { direction } => {
-            -direction * ct.sliding_coefficient * ct.friction_normal
-        }
-    };
+fn tangential_work(ct: &Contact, end_force: f64, slip: f64, impact: bool) -> (f64, f64, f64) {
     let average = -0.5 * (ct.start_shear_multiplier + end_force) * slip;
     let slid_to_a_close = ct.state.is_closed()
         && [ct.state, ct.start_state]
