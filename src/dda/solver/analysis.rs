@@ -5,6 +5,7 @@ use super::*;
 impl Dda {
     /// Static equilibrium under gravity and loads (the ground does not move).
     pub(super) fn settle(&mut self) -> Result<()> {
+        self.detection_for_next_step = None;
         // The weight is first let down on joints free to slip: a base slab that spreads
         // under its load (Poisson) then does not leave the joint's shear springs holding a
         // self-equilibrated force (at the frame's preload, most of ρN, so that the first
@@ -25,6 +26,7 @@ impl Dda {
             if !self.refines_free_to_slip() {
                 *self = settled;
             }
+            self.detection_for_next_step = None;
             for m in self.memory.values_mut() {
                 if m.state.is_closed() {
                     m.state = ContactState::Locked;
@@ -33,10 +35,12 @@ impl Dda {
             }
             return self.refine_settlement(Some(f64::INFINITY));
         }
+        self.detection_for_next_step = None;
         self.memory = saved_memory.clone();
         if self.settle_with(None).is_ok() {
             return self.refine_settlement(None);
         }
+        self.detection_for_next_step = None;
         self.memory = saved_memory;
         self.settle_with(Some(f64::INFINITY))?;
         self.refine_settlement(Some(f64::INFINITY))

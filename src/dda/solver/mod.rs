@@ -183,6 +183,12 @@ pub struct Dda {
     /// A second contact list, for the contacts of the geometry after a step while the
     /// step's own are still read (swapped, not copied).
     spare_contacts: Vec<Contact>,
+    /// `spare_contacts` are the contacts of the current geometry, found by the rebalance
+    /// after the last step with its memory and velocities, their penalties scaled for
+    /// the integrator's β held here: the next step takes them instead of searching again
+    /// (the search is a sixth of a large wall's step). Anything that changes the memory,
+    /// the geometry or the velocities before that step drops it.
+    detection_for_next_step: Option<f64>,
     memory: ContactMemories,
     bolts: Vec<Bolt>,
     fixed: Vec<FixedPoint>,
@@ -449,6 +455,7 @@ impl Dda {
             pairs,
             contacts: Vec::new(),
             spare_contacts: Vec::new(),
+            detection_for_next_step: None,
             memory: ContactMemories::default(),
             bolts,
             fixed,
@@ -491,8 +498,14 @@ impl Dda {
     }
 
     /// Finds the contacts of the current geometry (carrying over the memory of the last
-    /// step's).
+    /// step's), or takes those the rebalance after the last step found at this very
+    /// geometry (see `detection_for_next_step`).
     fn detect_contacts(&mut self) {
+        self.penalty_boost = 1.0;
+        if self.detection_for_next_step.take() == Some(self.coeffs.beta) {
+            std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
+            return;
+        }
         contact::detect(
             &self.blocks,
             &self.pairs,
@@ -500,7 +513,6 @@ impl Dda {
             self.search_distance,
             &mut self.contacts,
         );
-        self.penalty_boost = 1.0;
         if self.augmented() {
             self.scale_constraint_penalties();
         }
@@ -851,6 +863,7 @@ impl Dda {
             return Err(Error::invalid("velocity", "must be finite"));
         }
         block.velocity = velocity;
+        self.detection_for_next_step = None;
         Ok(())
     }
 

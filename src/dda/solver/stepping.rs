@@ -34,6 +34,7 @@ impl Dda {
 
     /// Moves blocks and joints by the increments and updates the contact memory.
     pub(super) fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
+        self.detection_for_next_step = None;
         let centroids = self.centroids();
         let maps: PerBlock<StepMap> = increments
             .iter()
@@ -402,6 +403,7 @@ impl Dda {
     /// its own impact when it closes. `impact`: the event is an impact, whose contacts
     /// are not landed on again within a nominal step.
     fn adopt_event_states(&mut self, impact: bool) {
+        self.detection_for_next_step = None;
         let pending = std::mem::take(&mut self.pending_events);
         let Some(&(primary, _)) = pending.first() else {
             return;
@@ -751,6 +753,7 @@ impl Dda {
             self.follow_curvature(self.grown_step());
             self.add_contact_forces(&mut out);
             std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
+            self.detection_for_next_step = Some(self.coeffs.beta);
         }
         out
     }
