@@ -208,9 +208,16 @@ impl Dda {
                         ContactState::Open => gap < -open_tolerance,
                         _ => judged_gap > open_tolerance,
                     };
-                    contradicted |=
-                        contradicts && p * judged_gap.abs() > FORCE_TOLERANCE * max_normal;
-                    continue;
+                    let beyond = contradicts && p * judged_gap.abs() > FORCE_TOLERANCE * max_normal;
+                    if !beyond {
+                        continue;
+                    }
+                    if pass == max_passes {
+                        contradicted = true;
+                        continue;
+                    }
+                    // Before the last pass, a contradiction beyond the tolerance takes
+                    // the state its gap asks for and is solved once more.
                 }
                 if new_state != c.state {
                     c.flips += 1;
