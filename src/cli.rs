@@ -801,9 +801,10 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     if s.dt_cuts > 0 {
         let why = s.dt_cut_reasons;
         out(&format!(
-            "  Δt cuts: {} because the open-close iteration did not settle, {} because a \
-             vertex moved too far in one step",
-            why.not_settled, why.too_far
+            "  Δt cuts: {} because a held contact contradicted its gap, {} because contacts \
+             still changed state, {} because friction forces still moved (at the last open-close \
+             pass), {} because a vertex moved too far in one step",
+            why.contradicted, why.states_changing, why.friction_changing, why.too_far
         ))?;
     }
     Ok(())

@@ -41,7 +41,7 @@ fn assert_ran_through(s: &FrameSummary, duration: f64) {
     );
     let why = s.dt_cut_reasons;
     assert_eq!(
-        why.not_settled + why.too_far,
+        why.total(),
         s.dt_cuts,
         "{}: every cut has its reason",
         s.scene

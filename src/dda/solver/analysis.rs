@@ -5,7 +5,7 @@ use super::*;
 impl Dda {
     /// Static equilibrium under gravity and loads (the ground does not move).
     pub(super) fn settle(&mut self) -> Result<()> {
-        self.detection_for_next_step = None;
+        self.forget_next_step_detection();
         // The weight is first let down on joints free to slip: a base slab that spreads
         // under its load (Poisson) then does not leave the joint's shear springs holding a
         // self-equilibrated force (at the frame's preload, most of ρN, so that the first
@@ -26,7 +26,7 @@ impl Dda {
             if !self.refines_free_to_slip() {
                 *self = settled;
             }
-            self.detection_for_next_step = None;
+            self.forget_next_step_detection();
             for m in self.memory.values_mut() {
                 if m.state.is_closed() {
                     m.state = ContactState::Locked;
@@ -35,13 +35,11 @@ impl Dda {
             }
             return self.refine_settlement(Some(f64::INFINITY));
         }
-        self.detection_for_next_step = None;
-        self.memory = saved_memory.clone();
+        self.restore_memory(saved_memory.clone());
         if self.settle_with(None).is_ok() {
             return self.refine_settlement(None);
         }
-        self.detection_for_next_step = None;
-        self.memory = saved_memory;
+        self.restore_memory(saved_memory);
         self.settle_with(Some(f64::INFINITY))?;
         self.refine_settlement(Some(f64::INFINITY))
     }
@@ -89,7 +87,7 @@ impl Dda {
     pub(super) fn settle_with(&mut self, friction: Option<f64>) -> Result<f64> {
         let known = vec![[0.0; 6]; self.blocks.len()];
         self.detect_contacts();
-        let Some((increments, _)) = self.iterate(Mode::Static { friction }, &known)? else {
+        let Ok((increments, _)) = self.iterate(Mode::Static { friction }, &known)? else {
             return Err(Error::Solver {
                 time: 0.0,
                 reason:

@@ -6,7 +6,7 @@ impl Dda {
     /// Makes the contacts' trial states (found at the very start of a step) their start
     /// states for the retry of the step.
     pub(super) fn adopt_trial_states(&mut self) {
-        self.detection_for_next_step = None;
+        self.forget_next_step_detection();
         for c in &self.contacts {
             if c.state == c.start_state {
                 continue;

@@ -7,14 +7,24 @@ use super::*;
 /// contact whose state is off by a smaller force is accepted (see `open_close`).
 const FORCE_TOLERANCE: f64 = 1e-4;
 
+/// Why the open-close iteration did not settle (what its last pass left undecided).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Unsettled {
+    /// A contact held after flipping contradicted its gap beyond the force tolerance.
+    Contradicted,
+    /// A contact still changed state.
+    StatesChanging,
+    /// Only a sliding contact's friction force still moved.
+    FrictionChanging,
+}
+
+/// The outcome of an open-close iteration: the increments of all blocks and the number of
+/// passes, or what kept it from settling.
+pub(super) type Settled = std::result::Result<(PerBlock<Vec6>, usize), Unsettled>;
+
 impl Dda {
-    /// Runs the open-close iteration. Returns the increments of all blocks and the number
-    /// of passes, or `None` if the states did not settle within the allowed passes.
-    pub(super) fn iterate(
-        &mut self,
-        mode: Mode,
-        known: &[Vec6],
-    ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
+    /// Runs the open-close iteration (see [`Settled`]).
+    pub(super) fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Settled> {
         self.refresh_element_terms();
         let elements = std::mem::take(&mut self.elements);
         let mut base = self
@@ -44,13 +54,17 @@ impl Dda {
         mode: Mode,
         known: &[Vec6],
         base: &System,
-    ) -> Result<Option<(PerBlock<Vec6>, usize)>> {
+    ) -> Result<Settled> {
         let open_tolerance = self.open_tolerance();
         let slip_tolerance = 1e-12 * self.structure_size;
         let max_passes = self.params.max_open_close_passes;
         // Inline for the systems the linear solver factorises on the stack.
         let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
+        let mut unsettled = Unsettled::StatesChanging;
         for pass in 1..=max_passes {
+            // In a dynamic step's last pass a contact still changing between stuck and
+            // sliding keeps its state (see below).
+            let last_dynamic_pass = pass == max_passes && matches!(mode, Mode::Dynamic { .. });
             let increments = self.solve_pass(mode, known, base, &mut solution)?;
             let velocities = match mode {
                 Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
@@ -59,7 +73,8 @@ impl Dda {
                 }
             };
             let augmented = self.augmented();
-            let mut changed = false;
+            let mut states_changed = false;
+            let mut friction_changed = false;
             let mut contradicted = false;
             // The scale of the friction normals' tolerance: the largest normal force the
             // pass found. (The forces it used may be predictions extrapolated from an
@@ -157,7 +172,7 @@ impl Dda {
                 let changed_normal =
                     (n_end - used_normal).abs() > FORCE_TOLERANCE * max_normal.max(n_end);
                 if sliding && (mu_moved || changed_normal) {
-                    changed = true;
+                    friction_changed = true;
                 }
                 // A normal force within the tolerance is left as the solve used it, as the
                 // coefficient below: the friction work booked is then the work of the
@@ -191,7 +206,6 @@ impl Dda {
                 // Kobe, 9 s: 883 cuts before, 285 with this and the force tolerance below).
                 // (The static settle keeps its own test of settled states.)
                 let stick_slip = c.state.is_closed() && new_state.is_closed();
-                let last_dynamic_pass = pass == max_passes && matches!(mode, Mode::Dynamic { .. });
                 let frozen = c.flips >= MAX_FLIPS_PER_STEP || (last_dynamic_pass && stick_slip);
                 if new_state != c.state && frozen {
                     // ...but never open while penetrating, nor closed while apart: the
@@ -239,7 +253,7 @@ impl Dda {
                             Mode::Static { .. } | Mode::Modal => 1.0,
                         };
                     }
-                    changed = true;
+                    states_changed = true;
                     // A contact that opens drops its multipliers; one that closes starts
                     // from none; one that starts to slide keeps its normal force.
                     if !new_state.is_closed() {
@@ -250,13 +264,18 @@ impl Dda {
                 }
             }
             if contradicted {
-                return Ok(None);
+                return Ok(Err(Unsettled::Contradicted));
             }
-            if !changed {
-                return Ok(Some((increments, pass)));
+            if !states_changed && !friction_changed {
+                return Ok(Ok((increments, pass)));
             }
+            unsettled = if states_changed {
+                Unsettled::StatesChanging
+            } else {
+                Unsettled::FrictionChanging
+            };
         }
-        Ok(None)
+        Ok(Err(unsettled))
     }
 
     /// Solves one open-close pass with the contacts' trial states: one linear solve with

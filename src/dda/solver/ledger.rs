@@ -5,7 +5,7 @@ use super::*;
 impl Dda {
     /// Makes the current state the reference: displacements and energies count from here.
     pub(super) fn reset_reference(&mut self) {
-        self.detection_for_next_step = None;
+        self.forget_next_step_detection();
         for b in &mut self.blocks {
             b.reference_centroid = b.moments.centroid;
             b.rotation = 0.0;

@@ -11,6 +11,8 @@ mod system;
 
 use std::sync::Arc;
 
+use iteration::Unsettled;
+
 use nalgebra::DVector;
 use serde::Serialize;
 use smallvec::SmallVec;
@@ -89,13 +91,31 @@ pub struct Modes {
 /// Δt cuts by what forced them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct CutReasons {
-    /// The open-close iteration did not settle in
-    /// [`SolverParams::max_open_close_passes`] passes (or judged a contact open while it
-    /// penetrates, or closed while apart).
-    pub not_settled: u64,
+    /// At the last of [`SolverParams::max_open_close_passes`] passes a contact, held in
+    /// its state after flipping within the step, contradicted its gap (open while
+    /// penetrating, or closed while apart) by more than the force tolerance.
+    pub contradicted: u64,
+    /// At the last pass a contact still changed state (opened or closed; in the static
+    /// settle also stuck ↔ sliding).
+    pub states_changing: u64,
+    /// At the last pass every state held, but a sliding contact's friction force (its
+    /// normal force or coefficient) still moved by more than the tolerance.
+    pub friction_changing: u64,
     /// A vertex moved more than [`SolverParams::max_displacement_ratio`] of the structure
     /// in one step.
     pub too_far: u64,
+}
+
+impl CutReasons {
+    /// The cuts because the open-close iteration did not settle (all but `too_far`).
+    pub fn not_settled(&self) -> u64 {
+        self.contradicted + self.states_changing + self.friction_changing
+    }
+
+    /// All cuts.
+    pub fn total(&self) -> u64 {
+        self.not_settled() + self.too_far
+    }
 }
 
 /// Totals over a run.
@@ -497,6 +517,19 @@ impl Dda {
         Ok(model)
     }
 
+    /// Drops the contacts the rebalance found for the next step: whatever changes the
+    /// contact memory, the geometry or the velocities calls this, as the next step must
+    /// then search again.
+    pub(super) fn forget_next_step_detection(&mut self) {
+        self.detection_for_next_step = None;
+    }
+
+    /// Puts back a contact memory saved earlier (and so forgets the next step's contacts).
+    pub(super) fn restore_memory(&mut self, memory: ContactMemories) {
+        self.forget_next_step_detection();
+        self.memory = memory;
+    }
+
     /// Finds the contacts of the current geometry (carrying over the memory of the last
     /// step's), or takes those the rebalance after the last step found at this very
     /// geometry (see `detection_for_next_step`).
@@ -863,7 +896,7 @@ impl Dda {
             return Err(Error::invalid("velocity", "must be finite"));
         }
         block.velocity = velocity;
-        self.detection_for_next_step = None;
+        self.forget_next_step_detection();
         Ok(())
     }
 

@@ -34,7 +34,7 @@ impl Dda {
 
     /// Moves blocks and joints by the increments and updates the contact memory.
     pub(super) fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
-        self.detection_for_next_step = None;
+        self.forget_next_step_detection();
         let centroids = self.centroids();
         let maps: PerBlock<StepMap> = increments
             .iter()
@@ -216,7 +216,7 @@ impl Dda {
             // scheme would apply half the contact's start force while the vertex moves
             // off, a push the contact cannot give (a toppling block's two corners, holding
             // 1.2e7 N after an impact, threw it up with 1.6 kJ more than it had).
-            if outcome.is_some()
+            if outcome.is_ok()
                 && restart == Restart::None
                 && self.coeffs != classic
                 && self.opens_a_loaded_contact()
@@ -243,7 +243,7 @@ impl Dda {
             let may_land = self.time - self.last_landing >= horizon;
             let now = self.time;
             self.recent_impacts.retain(|&(_, t)| now - t < horizon);
-            if outcome.is_some() && self.params.locate_events && dt_override.is_none() {
+            if outcome.is_ok() && self.params.locate_events && dt_override.is_none() {
                 let fresh = |c: &Contact| self.recent_impacts.iter().all(|&(k, _)| k != c.key);
                 let (theta, impact, primary) = self
                     .contacts
@@ -321,14 +321,8 @@ impl Dda {
                 }
             }
             let reason = match outcome {
-                None => {
-                    self.counters.cut_reasons.not_settled += 1;
-                    format!(
-                        "the open-close iteration did not settle in {} passes",
-                        self.params.max_open_close_passes
-                    )
-                }
-                Some((increments, passes)) => {
+                Err(why) => self.count_unsettled(why),
+                Ok((increments, passes)) => {
                     let ratio = self.max_relative_displacement(&increments, &known);
                     if ratio <= self.params.max_displacement_ratio {
                         let report = self.commit_step(
@@ -387,6 +381,29 @@ impl Dda {
         }
     }
 
+    /// Counts a cut because the open-close iteration did not settle; returns why, in words.
+    fn count_unsettled(&mut self, why: Unsettled) -> String {
+        let reasons = &mut self.counters.cut_reasons;
+        let passes = self.params.max_open_close_passes;
+        match why {
+            Unsettled::Contradicted => {
+                reasons.contradicted += 1;
+                format!(
+                    "after {passes} open-close passes a contact held in its state contradicted \
+                     its gap (open while penetrating, or closed while apart)"
+                )
+            }
+            Unsettled::StatesChanging => {
+                reasons.states_changing += 1;
+                format!("contacts still changed state after {passes} open-close passes")
+            }
+            Unsettled::FrictionChanging => {
+                reasons.friction_changing += 1;
+                format!("friction forces still moved after {passes} open-close passes")
+            }
+        }
+    }
+
     /// Whether a contact that started the step carrying a force ends it open.
     fn opens_a_loaded_contact(&self) -> bool {
         self.contacts
@@ -403,7 +420,7 @@ impl Dda {
     /// its own impact when it closes. `impact`: the event is an impact, whose contacts
     /// are not landed on again within a nominal step.
     fn adopt_event_states(&mut self, impact: bool) {
-        self.detection_for_next_step = None;
+        self.forget_next_step_detection();
         let pending = std::mem::take(&mut self.pending_events);
         let Some(&(primary, _)) = pending.first() else {
             return;
