@@ -384,24 +384,25 @@ impl Dda {
     /// Counts a cut because the open-close iteration did not settle; returns why, in words.
     fn count_unsettled(&mut self, why: Unsettled) -> String {
         let reasons = &mut self.counters.cut_reasons;
-        let passes = self.params.max_open_close_passes;
-        match why {
+        let what = match why {
             Unsettled::Contradicted => {
                 reasons.contradicted += 1;
-                format!(
-                    "after {passes} open-close passes a contact held in its state contradicted \
-                     its gap (open while penetrating, or closed while apart)"
-                )
+                "a contact held in its state contradicted its gap (open while penetrating, or \
+                 closed while apart)"
             }
             Unsettled::StatesChanging => {
                 reasons.states_changing += 1;
-                format!("contacts still changed state after {passes} open-close passes")
+                "contacts still changed state"
             }
             Unsettled::FrictionChanging => {
                 reasons.friction_changing += 1;
-                format!("friction forces still moved after {passes} open-close passes")
+                "friction forces still moved"
             }
-        }
+        };
+        format!(
+            "the open-close iteration did not settle in {} passes ({what})",
+            self.params.max_open_close_passes
+        )
     }
 
     /// Whether a contact that started the step carrying a force ends it open.
