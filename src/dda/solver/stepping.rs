@@ -445,6 +445,14 @@ impl Dda {
             if !augmented || m.state == state {
                 continue;
             }
+            // A contact the landed step closed and left carrying a force keeps it: the
+            // step's end accelerations balance that force, and opening it here would
+            // leave them holding a force no contact carries (the next step's ledger then
+            // booked half its work: a toppling block lost 93 J unbooked). The next step
+            // judges it.
+            if !state.is_closed() && m.state.is_closed() && m.normal_force > 0.0 {
+                continue;
+            }
             m.state = state;
             m.shear = 0.0;
             if !state.is_closed() {
