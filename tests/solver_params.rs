@@ -146,7 +146,7 @@ fn exact_rotation_keeps_a_spinning_block_rigid_and_the_linear_map_inflates_it() 
 /// Δt is cut. On the incline the attempts where the block starts to slide take up to 5
 /// passes (an attempt that then lands on the stick-slip event is not the one reported, so
 /// the accepted steps show at most 4). The least limit at which no step is cut, P, leaves
-/// the run bit for bit as with the default 8; a limit of P − 1 cuts steps, never accepts a
+/// the run bit for bit as with the default 16; a limit of P − 1 cuts steps, never accepts a
 /// step with more passes than the limit, and the block still slides as
 /// ½ g (sin θ − μ cos θ) t² to 1e-3 (the travel error of starting the slide half a nominal
 /// step late); with no cut allowed (`min_dt_fraction` = 1) the solver stops at the first
