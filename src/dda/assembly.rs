@@ -116,8 +116,8 @@ impl System {
         for part in parts.iter() {
             let Some((bp, vp)) = *part else { continue };
             let Some(sp) = dofs.slot[bp] else { continue };
-            for i in 0..6 {
-                self.r[sp + i] -= f0 * vp[i];
+            for (ri, vi) in self.r.as_mut_slice()[sp..sp + 6].iter_mut().zip(vp) {
+                *ri -= f0 * vi;
             }
             for qpart in parts.iter() {
                 let Some((bq, vq)) = *qpart else { continue };

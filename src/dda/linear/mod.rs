@@ -291,14 +291,20 @@ impl BlockMatrix {
     /// ‖K‖∞, the largest absolute row sum; `rows` (one per unknown) is scratch.
     pub fn norm_inf(&self, rows: &mut [f64]) -> f64 {
         rows.iter_mut().for_each(|v| *v = 0.0);
+        // Row i's sums take each block row in column order and row j's (the transpose)
+        // in row order, as one loop over the entries would; split in two loops, the
+        // second adds whole rows at once.
         for (e, &(i, j)) in self.pattern.entries.iter().enumerate() {
             let b = &self.blocks[e];
-            for r in 0..6 {
-                for c in 0..6 {
-                    let v = b[r][c].abs();
-                    rows[6 * i + r] += v;
-                    if i != j {
-                        rows[6 * j + c] += v;
+            for (r, row) in b.iter().enumerate() {
+                for v in row {
+                    rows[6 * i + r] += v.abs();
+                }
+            }
+            if i != j {
+                for row in b {
+                    for (sum, v) in rows[6 * j..6 * j + 6].iter_mut().zip(row) {
+                        *sum += v.abs();
                     }
                 }
             }
