@@ -21,18 +21,14 @@
 use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
-    factorize_symbolic_cholesky,
-};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Par, Side};
+use faer::sparse::SymbolicSparseColMatRef;
 
 use super::block::Mat6;
 use envelope::{Envelope, EnvelopeCholesky};
+use sparse::SparseCholesky;
 
 mod envelope;
+mod sparse;
 
 /// Which 6×6 blocks of the matrix can be non-zero: pairs (i, j), i ≤ j, of free blocks
 /// (numbered in unknown order: block k owns unknowns 6k..6k+6).
@@ -354,14 +350,16 @@ impl BlockMatrix {
     }
 
     /// Writes the upper-triangle compressed-column values.
-    fn fill_compressed(&self, values: &mut [f64]) {
+    /// Writes the stored values in compressed-column order, value `p` at `values[at[p]]`
+    /// (a sparse factor's ordering).
+    fn fill_compressed(&self, values: &mut [f64], at: &[usize]) {
         for (e, block) in self.blocks.iter().enumerate() {
             let map = &self.pattern.scatter[e];
             for r in 0..6 {
                 for c in 0..6 {
                     let p = map[6 * r + c];
                     if p != usize::MAX {
-                        values[p] = block[r][c];
+                        values[at[p]] = block[r][c];
                     }
                 }
             }
@@ -494,11 +492,7 @@ impl Tiny {
 enum Factor {
     Tiny(Tiny),
     Envelope(EnvelopeCholesky),
-    Sparse {
-        symbolic: Arc<SymbolicCholesky<usize>>,
-        l_values: Vec<f64>,
-        a_values: Vec<f64>,
-    },
+    Sparse(SparseCholesky),
 }
 
 /// Cholesky solver of [`BlockMatrix`] systems that keeps its symbolic analysis for the
@@ -601,15 +595,7 @@ impl Factor {
                 Tiny::B4(_) => Tiny::B4(None),
             }),
             Factor::Envelope(l) => Factor::Envelope(l.empty_like()),
-            Factor::Sparse {
-                symbolic,
-                l_values,
-                a_values,
-            } => Factor::Sparse {
-                symbolic: Arc::clone(symbolic),
-                l_values: vec![0.0; l_values.len()],
-                a_values: vec![0.0; a_values.len()],
-            },
+            Factor::Sparse(l) => Factor::Sparse(l.empty_like()),
         }
     }
 }
@@ -636,10 +622,7 @@ impl Clone for LinearSolver {
 fn scratch_size(factor: &Factor) -> StackReq {
     match factor {
         Factor::Tiny(_) | Factor::Envelope(_) => StackReq::EMPTY,
-        Factor::Sparse { symbolic, .. } => StackReq::any_of(&[
-            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
-            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-        ]),
+        Factor::Sparse(l) => l.scratch(),
     }
 }
 
@@ -662,10 +645,14 @@ impl LinearSolver {
                 let stored = 36 * envelope.stored_blocks();
                 iteration_budget(envelope.factorisation_cost(), stored, matrix_nonzeros)
             }
-            Factor::Sparse { l_values, .. } => {
-                let stored = l_values.len() as f64;
+            Factor::Sparse(l) => {
+                let stored = l.factor_nonzeros() as f64;
                 let flops = stored * stored / n as f64;
-                iteration_budget(flops / SUPERNODAL_SPEEDUP, l_values.len(), matrix_nonzeros)
+                iteration_budget(
+                    flops / SUPERNODAL_SPEEDUP,
+                    l.factor_nonzeros(),
+                    matrix_nonzeros,
+                )
             }
         };
         Ok(Self {
@@ -690,21 +677,11 @@ impl LinearSolver {
         if pattern.unknowns() <= ENVELOPE_LIMIT {
             return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
         }
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.symbolic(),
-            Side::Upper,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|_| SolveError::OutsidePattern)?;
-        if 36 * envelope.stored_blocks() <= symbolic.len_val() {
+        let sparse = SparseCholesky::new(pattern)?;
+        if 36 * envelope.stored_blocks() <= sparse.factor_nonzeros() {
             return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
         }
-        Ok(Factor::Sparse {
-            l_values: vec![0.0; symbolic.len_val()],
-            a_values: vec![0.0; pattern.row_idx.len()],
-            symbolic: Arc::new(symbolic),
-        })
+        Ok(Factor::Sparse(sparse))
     }
 
     /// Whether the last solve was by conjugate gradients on a kept factor (whose residual
@@ -927,62 +904,33 @@ impl LinearSolver {
         match &mut slot.factor {
             Factor::Tiny(tiny) => tiny.factorize(k)?,
             Factor::Envelope(l) => l.factorize(k)?,
-            Factor::Sparse {
-                symbolic,
-                l_values,
-                a_values,
-            } => {
-                k.fill_compressed(a_values);
-                let a = SparseColMatRef::new(self.pattern.symbolic(), a_values);
-                symbolic
-                    .factorize_numeric_llt(
-                        l_values,
-                        a,
-                        Side::Upper,
-                        LltRegularization::default(),
-                        Par::Seq,
-                        stack,
-                        Default::default(),
-                    )
-                    .map_err(|_| SolveError::NotPositiveDefinite)?;
-            }
+            Factor::Sparse(l) => l.factorize(k, stack)?,
         }
         Ok(())
     }
 
     /// x ← K⁻¹ x with the kept factor.
     fn apply_inverse(&mut self, x: &mut [f64]) {
-        let n = x.len();
         match &mut self.slots[self.active].factor {
             Factor::Tiny(tiny) => tiny.solve(x),
             Factor::Envelope(l) => l.solve(x),
-            Factor::Sparse {
-                symbolic, l_values, ..
-            } => {
-                let rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
-                LltRef::<'_, usize, f64>::new(symbolic, l_values).solve_in_place_with_conj(
-                    Conj::No,
-                    rhs,
-                    Par::Seq,
-                    MemStack::new(&mut self.scratch),
-                );
-            }
+            Factor::Sparse(l) => l.solve(x, MemStack::new(&mut self.scratch)),
         }
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// A random-ish SPD block matrix on a ring pattern (a chain closed on itself).
-    fn chain(blocks: usize, seed: u64) -> BlockMatrix {
+    pub(super) fn chain(blocks: usize, seed: u64) -> BlockMatrix {
         let ring: Vec<(usize, usize)> = (0..blocks).map(|i| (i, (i + 1) % blocks)).collect();
         springs(blocks, &ring, seed)
     }
 
     /// A random-ish SPD block matrix with a spring on each of the block pairs `pairs`.
-    fn springs(blocks: usize, pairs: &[(usize, usize)], seed: u64) -> BlockMatrix {
+    pub(super) fn springs(blocks: usize, pairs: &[(usize, usize)], seed: u64) -> BlockMatrix {
         let pattern = Arc::new(BlockPattern::new(blocks, pairs.iter().copied()));
         let mut k = BlockMatrix::zeros(pattern);
         let mut s = seed;
