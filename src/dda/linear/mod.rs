@@ -349,7 +349,6 @@ impl BlockMatrix {
         }
     }
 
-    /// Writes the upper-triangle compressed-column values.
     /// Writes the stored values in compressed-column order, value `p` at `values[at[p]]`
     /// (a sparse factor's ordering).
     fn fill_compressed(&self, values: &mut [f64], at: &[usize]) {
@@ -677,11 +676,11 @@ impl LinearSolver {
         if pattern.unknowns() <= ENVELOPE_LIMIT {
             return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
         }
-        let sparse = SparseCholesky::new(pattern)?;
-        if 36 * envelope.stored_blocks() <= sparse.factor_nonzeros() {
+        let symbolic = SparseCholesky::analyse(pattern)?;
+        if 36 * envelope.stored_blocks() <= symbolic.len_val() {
             return Ok(Factor::Envelope(EnvelopeCholesky::new(Arc::new(envelope))));
         }
-        Ok(Factor::Sparse(sparse))
+        Ok(Factor::Sparse(SparseCholesky::new(pattern, symbolic)))
     }
 
     /// Whether the last solve was by conjugate gradients on a kept factor (whose residual

@@ -75,27 +75,32 @@ pub(super) struct SparseCholesky {
 }
 
 impl SparseCholesky {
-    /// The symbolic analysis of `pattern` (AMD ordering), with no numeric factor yet.
-    pub(super) fn new(pattern: &BlockPattern) -> Result<Self, SolveError> {
-        let symbolic = factorize_symbolic_cholesky(
+    /// The symbolic analysis of `pattern` (AMD ordering): enough to compare the factor's
+    /// size with the envelope's before the factor itself is set up.
+    pub(super) fn analyse(pattern: &BlockPattern) -> Result<SymbolicCholesky<usize>, SolveError> {
+        factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Upper,
             SymmetricOrdering::Amd,
             CholeskySymbolicParams::default(),
         )
-        .map_err(|_| SolveError::OutsidePattern)?;
+        .map_err(|_| SolveError::OutsidePattern)
+    }
+
+    /// A factor on the analysis `symbolic` of `pattern`, with no numeric factor yet.
+    pub(super) fn new(pattern: &BlockPattern, symbolic: SymbolicCholesky<usize>) -> Self {
         let identity: Vec<usize> = (0..pattern.unknowns()).collect();
         let perm = match symbolic.perm() {
             Some(perm) => perm,
             None => PermRef::new_checked(&identity, &identity, identity.len()),
         };
         let permuted = PermutedPattern::new(pattern, perm, read_side(&symbolic));
-        Ok(Self {
+        Self {
             l_values: vec![0.0; symbolic.len_val()],
             a_values: vec![0.0; permuted.position.len()],
             symbolic: Arc::new(symbolic),
             permuted: Arc::new(permuted),
-        })
+        }
     }
 
     /// A factor on the same analysis, with no numeric factor.
@@ -202,7 +207,8 @@ mod tests {
             .collect();
         for k in [chain(40, 7), springs(64, &grid, 3)] {
             let pattern = k.pattern();
-            let mut ours = SparseCholesky::new(pattern).unwrap();
+            let symbolic = SparseCholesky::analyse(pattern).unwrap();
+            let mut ours = SparseCholesky::new(pattern, symbolic);
             let mut buffer = MemBuffer::new(ours.scratch());
             ours.factorize(&k, MemStack::new(&mut buffer)).unwrap();
 
