@@ -49,18 +49,16 @@ impl ElementTerms {
         }
     }
 
-    /// Adds the stiffness `ke` (2n × 2n) and forces `fe` of an element of `n` nodes, whose
-    /// node k is this element's node `map[k]`.
-    fn add_parts(&mut self, n: usize, ke: &[f64], fe: &[f64], map: &[usize; MAX_NODES]) {
-        let (dim, own_dim) = (2 * n, 2 * self.count);
-        let at: [usize; 2 * MAX_NODES] = std::array::from_fn(|i| 2 * map[i / 2] + i % 2);
-        for i in 0..dim {
-            self.fe[at[i]] += fe[i];
-            let row = at[i] * own_dim;
-            for j in 0..dim {
-                self.ke[row + at[j]] += ke[i * dim + j];
-            }
-        }
+    /// Adds the stiffness and forces of connection `c`, whose node k is this element's
+    /// node `map[k]`.
+    fn add_connection(&mut self, c: &Connection, map: &[usize; MAX_NODES]) {
+        let own_dim = 2 * self.count;
+        let at: [usize; 6] = std::array::from_fn(|i| 2 * map[i / 2] + i % 2);
+        let (ke, fe) = (&mut self.ke, &mut self.fe);
+        c.visit_local_terms(
+            |i, j, v| ke[at[i] * own_dim + at[j]] += v,
+            |i, v| fe[at[i]] += v,
+        );
     }
 
     /// Nodes: (block, current position).
@@ -178,12 +176,39 @@ impl ConnectionGroups {
                 let (ci, node) = g.sources[k];
                 connections[ci].node_list()[node]
             });
-            let mut terms = ElementTerms::with_nodes(&nodes[..g.nodes]);
+            // Built in place: the terms are larger than the work of filling them.
+            let index = out.len();
+            out.push(ElementTerms::with_nodes(&nodes[..g.nodes]));
+            let terms = &mut out[index];
             for (map, c) in g.maps.iter().zip(&connections[g.first..g.first + g.len]) {
-                let (ke, fe) = c.local_terms();
-                terms.add_parts(3, &ke, &fe, map);
+                terms.add_connection(c, map);
             }
-            out.push(terms);
+        }
+    }
+
+    /// Moves every connection by this step's motion (see [`Connection::commit`]). A node
+    /// shared by the triangles of a group is one point carried by one block, so its
+    /// displacements are computed once for the group and handed to each triangle: the
+    /// triangles' copies of it stay equal to the bit, as they were when grouped.
+    pub fn commit(&self, connections: &mut [Connection], motion: &impl NodeMotion) {
+        for g in &self.groups {
+            let mut linear = [[0.0; 2]; MAX_NODES];
+            let mut exact = [[0.0; 2]; MAX_NODES];
+            for (k, &(ci, node)) in g.sources[..g.nodes].iter().enumerate() {
+                let (b, x) = connections[ci].node_list()[node];
+                linear[k] = motion.linear_node_displacement(b, x);
+                exact[k] = motion.node_displacement(b, x);
+            }
+            for (map, c) in g
+                .maps
+                .iter()
+                .zip(&mut connections[g.first..g.first + g.len])
+            {
+                c.commit_displaced(
+                    std::array::from_fn(|k| linear[map[k]]),
+                    std::array::from_fn(|k| exact[map[k]]),
+                );
+            }
         }
     }
 }
@@ -531,14 +556,25 @@ impl Connection {
     /// by node pair: B's node block is `[[b, 0], [0, c], [c, b]] / 2A`, so the pair (k, l)
     /// is `[[bₖ, 0, cₖ], [0, cₖ, bₖ]] C [[bₗ, 0], [0, cₗ], [cₗ, bₗ]] / 4A`.
     pub fn local_terms(&self) -> ([f64; 36], [f64; 6]) {
+        let (mut ke, mut fe) = ([0.0; 36], [0.0; 6]);
+        self.visit_local_terms(|i, j, v| ke[i * 6 + j] = v, |i, v| fe[i] = v);
+        (ke, fe)
+    }
+
+    /// Hands each entry of [`Connection::local_terms`] to `stiffness(row, column, value)`
+    /// and `force(row, value)`, so that a group adds them where they belong without a
+    /// copy of the triangle's own matrix.
+    fn visit_local_terms(
+        &self,
+        mut stiffness: impl FnMut(usize, usize, f64),
+        mut force: impl FnMut(usize, f64),
+    ) {
         let [p1, p2, p3] = self.nodes;
         let two_a = (p2[0] - p1[0]) * (p3[1] - p1[1]) - (p3[0] - p1[0]) * (p2[1] - p1[1]);
         let b = [p2[1] - p3[1], p3[1] - p1[1], p1[1] - p2[1]];
         let c = [p3[0] - p2[0], p1[0] - p3[0], p2[0] - p1[0]];
         let e = &self.elasticity;
         let scale = 1.0 / (2.0 * two_a);
-        let mut ke = [0.0; 36];
-        let mut fe = [0.0; 6];
         for k in 0..3 {
             // Bₖᵀ (2 × 3) times C, row by row.
             let rows = [
@@ -554,17 +590,16 @@ impl Connection {
                 ],
             ];
             let sigma = &self.stress;
-            fe[2 * k] = 0.5 * (b[k] * sigma[0] + c[k] * sigma[2]);
-            fe[2 * k + 1] = 0.5 * (c[k] * sigma[1] + b[k] * sigma[2]);
+            force(2 * k, 0.5 * (b[k] * sigma[0] + c[k] * sigma[2]));
+            force(2 * k + 1, 0.5 * (c[k] * sigma[1] + b[k] * sigma[2]));
             for l in 0..3 {
                 for (r, row) in rows.iter().enumerate() {
-                    let i = (2 * k + r) * 6 + 2 * l;
-                    ke[i] = scale * (row[0] * b[l] + row[2] * c[l]);
-                    ke[i + 1] = scale * (row[1] * c[l] + row[2] * b[l]);
+                    let i = 2 * k + r;
+                    stiffness(i, 2 * l, scale * (row[0] * b[l] + row[2] * c[l]));
+                    stiffness(i, 2 * l + 1, scale * (row[1] * c[l] + row[2] * b[l]));
                 }
             }
         }
-        (ke, fe)
     }
 
     /// Elastic energy, J: the work the element's forces (`fe`, `ke` of each step) did on
@@ -579,14 +614,27 @@ impl Connection {
     /// Books the work of this step's forces on its strain increment, moves the nodes and
     /// takes the strain and stress of the new shape.
     pub fn commit(&mut self, motion: &impl NodeMotion) {
+        let at = |k: usize| (self.blocks[k], self.nodes[k]);
+        let linear = std::array::from_fn(|k| {
+            let (b, x) = at(k);
+            motion.linear_node_displacement(b, x)
+        });
+        let exact = std::array::from_fn(|k| {
+            let (b, x) = at(k);
+            motion.node_displacement(b, x)
+        });
+        self.commit_displaced(linear, exact);
+    }
+
+    /// [`Connection::commit`] with the nodes' displacements given: `lin` under the
+    /// linear map the step was solved with, `u` as the nodes move.
+    fn commit_displaced(&mut self, lin: [Point; 3], u: [Point; 3]) {
         let (area, b) = self.b_matrix();
         // The strain increment from the linear node displacements the step was solved
         // with, so that the element stores the work the solve did on it. The exact ones
         // would strain a rigidly turning element by cos θ − 1, and a column connection
         // carrying a floor's weight would then take energy from gravity at every step
         // (the three-storey frame's fixed-base energy residual was 6e-2, O(Δt)).
-        let lin: [Point; 3] =
-            std::array::from_fn(|k| motion.linear_node_displacement(self.blocks[k], self.nodes[k]));
         let flat: Vec6 = [
             lin[0][0], lin[0][1], lin[1][0], lin[1][1], lin[2][0], lin[2][1],
         ];
@@ -599,8 +647,6 @@ impl Connection {
             let change: f64 = (0..3).map(|j| self.elasticity[i][j] * de[j]).sum();
             self.stored_energy += area * (self.stress[i] + 0.5 * change) * de[i];
         }
-        let u: [Point; 3] =
-            std::array::from_fn(|k| motion.node_displacement(self.blocks[k], self.nodes[k]));
         for (p, d) in self.nodes.iter_mut().zip(u.iter()) {
             p[0] += d[0];
             p[1] += d[1];

@@ -9,6 +9,12 @@ pub fn transpose(m: &Mat6) -> Mat6 {
     std::array::from_fn(|r| std::array::from_fn(|c| m[c][r]))
 }
 
+/// The start of a sum, as `Iterator::sum` starts one: with −0.0, the neutral element of
+/// addition. [`divide_by_transposed`] sums six dot products side by side (so that the
+/// compiler can put them in vector lanes), each in the order `sum` would, from the same
+/// start: the results are those of one dot product after the other, to the bit.
+const SUM_START: f64 = -0.0;
+
 /// s ← s − a bᵀ.
 pub fn subtract_product_transposed(s: &mut Mat6, a: &Mat6, b: &Mat6) {
     for (sr, ar) in s.iter_mut().zip(a) {
@@ -20,33 +26,50 @@ pub fn subtract_product_transposed(s: &mut Mat6, a: &Mat6, b: &Mat6) {
 
 /// The lower Cholesky factor L of the symmetric positive definite `s` (its lower half
 /// read), in place, its upper half zeroed; the reciprocals of L's diagonal into
-/// `inverse`. `None` if `s` is not positive definite (or not finite).
+/// `inverse`. `None` if `s` is not positive definite (or not finite). Column by column on
+/// the transpose, the column's six dot products side by side (see [`SUM_START`]).
 pub fn cholesky(s: &mut Mat6, inverse: &mut [f64; 6]) -> Option<()> {
+    // Row k of the transpose is column k of L below the diagonal once it is computed.
+    let mut s_t = transpose(s);
     for c in 0..6 {
-        let pivot = s[c][c] - (0..c).map(|k| s[c][k] * s[c][k]).sum::<f64>();
+        let mut dots = [SUM_START; 6];
+        for k in 0..c {
+            let l_ck = s_t[k][c];
+            for (dot, &l_rk) in dots.iter_mut().zip(&s_t[k]) {
+                *dot += l_rk * l_ck;
+            }
+        }
+        let pivot = s_t[c][c] - dots[c];
         if pivot.is_nan() || pivot <= 0.0 {
             return None;
         }
         let l = pivot.sqrt();
-        s[c][c] = l;
+        s_t[c][c] = l;
         inverse[c] = 1.0 / l;
         for r in c + 1..6 {
-            s[r][c] = (s[r][c] - (0..c).map(|k| s[r][k] * s[c][k]).sum::<f64>()) * inverse[c];
-        }
-        for value in &mut s[c][c + 1..] {
-            *value = 0.0;
+            s_t[c][r] = (s_t[c][r] - dots[r]) * inverse[c];
         }
     }
+    *s = std::array::from_fn(|r| std::array::from_fn(|c| if c <= r { s_t[c][r] } else { 0.0 }));
     Some(())
 }
 
-/// s ← s L⁻ᵀ for a lower triangular L (row by row: x Lᵀ = s is a forward substitution).
+/// s ← s L⁻ᵀ for a lower triangular L (row by row: x Lᵀ = s is a forward substitution;
+/// the six rows' substitutions run side by side, on the transpose).
 pub fn divide_by_transposed(s: &mut Mat6, l: &Mat6, inverse: &[f64; 6]) {
-    for row in s.iter_mut() {
-        for c in 0..6 {
-            row[c] = (row[c] - (0..c).map(|k| row[k] * l[c][k]).sum::<f64>()) * inverse[c];
+    let mut s_t = transpose(s);
+    for c in 0..6 {
+        let mut dots = [SUM_START; 6];
+        for k in 0..c {
+            for (dot, &x) in dots.iter_mut().zip(&s_t[k]) {
+                *dot += x * l[c][k];
+            }
+        }
+        for (x, dot) in s_t[c].iter_mut().zip(dots) {
+            *x = (*x - dot) * inverse[c];
         }
     }
+    *s = transpose(&s_t);
 }
 
 /// y ← y − m x.

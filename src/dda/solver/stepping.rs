@@ -52,9 +52,8 @@ impl Dda {
         for f in &mut self.fixed {
             f.commit(&motion);
         }
-        for c in &mut self.connections {
-            c.commit(&motion);
-        }
+        self.connection_groups
+            .commit(&mut self.connections, &motion);
         for l in &mut self.loads {
             let u = motion.node_displacement(l.block, l.point);
             l.point[0] += u[0];
