@@ -20,11 +20,26 @@ pub const NO_DISPLAY_HELP: &str = "no display to open a window on; the same simu
 const FRAME_INTERVAL: Duration = Duration::from_micros(16_667);
 
 /// While a run is being computed the window redraws at most this often (10 frames a
-/// second): its frames are drawn by the same cores that compute, and where they are drawn
-/// in software (Mesa's llvmpipe, a machine without a GPU) a frame costs ~50 ms of CPU.
-/// The default run then computes at 22–23× real time in the window instead of 17–18× at
-/// 30 frames a second (docs/performance.md); the computation lasts a second or two.
+/// second): its frames are drawn by the same cores that compute. The default run then
+/// computes at 22–23× real time in the window instead of 17–18× at 30 frames a second
+/// (docs/performance.md); the computation lasts a second or two.
 const COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(100);
+
+/// The same where the frames are drawn in software (Mesa's llvmpipe, a machine without a
+/// GPU): a frame of the default layout at 1600×900 costs ~55 ms of CPU there, so at 10
+/// frames a second the drawing took half a core from the two simulations (17–18× real
+/// time under Xvfb against 22–24× at 4 frames a second; docs/performance.md). Input still
+/// repaints at once; only the computing run's own redraws are paced.
+const SOFTWARE_COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(250);
+
+/// How often the window redraws while a run computes, for the adapter that draws it.
+fn computing_frame_interval(adapter: &wgpu::AdapterInfo) -> Duration {
+    if adapter.device_type == wgpu::DeviceType::Cpu {
+        SOFTWARE_COMPUTING_FRAME_INTERVAL
+    } else {
+        COMPUTING_FRAME_INTERVAL
+    }
+}
 
 struct App {
     state: AppState,
@@ -35,6 +50,8 @@ struct App {
     started: Instant,
     dark: Option<bool>,
     frames_drawn: u64,
+    /// The pace of redraws while a run computes (see [`computing_frame_interval`]).
+    computing_interval: Duration,
     /// Screenshots saved (or failed) on the render thread.
     shots_tx: std::sync::mpsc::Sender<std::result::Result<std::path::PathBuf, String>>,
     shots_rx: std::sync::mpsc::Receiver<std::result::Result<std::path::PathBuf, String>>,
@@ -74,9 +91,10 @@ pub fn run_app() -> Result<()> {
                     &render_state.device,
                     render_state.target_format,
                 ));
+            let computing_interval = computing_frame_interval(&render_state.adapter.get_info());
             let ctx = cc.egui_ctx.clone();
             let sim = SimHandle::spawn_with_waker(Box::new(move || {
-                ctx.request_repaint_after(COMPUTING_FRAME_INTERVAL)
+                ctx.request_repaint_after(computing_interval)
             }));
             let (shots_tx, shots_rx) = std::sync::mpsc::channel();
             Ok(Box::new(App {
@@ -89,6 +107,7 @@ pub fn run_app() -> Result<()> {
                 started: Instant::now(),
                 dark: None,
                 frames_drawn: 0,
+                computing_interval,
                 shots_tx,
                 shots_rx,
             }))
@@ -182,12 +201,12 @@ impl eframe::App for App {
         self.shell_requests(&ctx);
         self.frames_drawn += 1;
         if self.state.playing && self.state.animating() {
-            // Paced: the next frame no sooner than 1/60 s after this one began (1/10 s
+            // Paced: the next frame no sooner than 1/60 s after this one began (slower
             // while the run is still being computed).
             let interval = if self.state.timeline.finished {
                 FRAME_INTERVAL
             } else {
-                COMPUTING_FRAME_INTERVAL
+                self.computing_interval
             };
             ctx.request_repaint_after(interval.saturating_sub(now.elapsed()));
         }
