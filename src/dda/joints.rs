@@ -50,15 +50,19 @@ impl ElementTerms {
     }
 
     /// Adds the stiffness and forces of connection `c`, whose node k is this element's
-    /// node `map[k]`.
+    /// node `map[k]` (a node's two entries stay side by side).
     fn add_connection(&mut self, c: &Connection, map: &[usize; MAX_NODES]) {
+        let (ke, fe) = c.local_terms();
         let own_dim = 2 * self.count;
-        let at: [usize; 6] = std::array::from_fn(|i| 2 * map[i / 2] + i % 2);
-        let (ke, fe) = (&mut self.ke, &mut self.fe);
-        c.visit_local_terms(
-            |i, j, v| ke[at[i] * own_dim + at[j]] += v,
-            |i, v| fe[at[i]] += v,
-        );
+        for (i, (ke_row, f)) in ke.chunks_exact(6).zip(fe).enumerate() {
+            let own_i = 2 * map[i / 2] + i % 2;
+            self.fe[own_i] += f;
+            for (l, pair) in ke_row.chunks_exact(2).enumerate() {
+                let at = own_i * own_dim + 2 * map[l];
+                self.ke[at] += pair[0];
+                self.ke[at + 1] += pair[1];
+            }
+        }
     }
 
     /// Nodes: (block, current position).
@@ -555,26 +559,20 @@ impl Connection {
     /// `ke = A Bᵀ C B` (6 × 6, row-major) and `fe = A Bᵀ σ` on the three nodes, node pair
     /// by node pair: B's node block is `[[b, 0], [0, c], [c, b]] / 2A`, so the pair (k, l)
     /// is `[[bₖ, 0, cₖ], [0, cₖ, bₖ]] C [[bₗ, 0], [0, cₗ], [cₗ, bₗ]] / 4A`.
+    #[inline]
     pub fn local_terms(&self) -> ([f64; 36], [f64; 6]) {
-        let (mut ke, mut fe) = ([0.0; 36], [0.0; 6]);
-        self.visit_local_terms(|i, j, v| ke[i * 6 + j] = v, |i, v| fe[i] = v);
-        (ke, fe)
-    }
-
-    /// Hands each entry of [`Connection::local_terms`] to `stiffness(row, column, value)`
-    /// and `force(row, value)`, so that a group adds them where they belong without a
-    /// copy of the triangle's own matrix.
-    fn visit_local_terms(
-        &self,
-        mut stiffness: impl FnMut(usize, usize, f64),
-        mut force: impl FnMut(usize, f64),
-    ) {
         let [p1, p2, p3] = self.nodes;
         let two_a = (p2[0] - p1[0]) * (p3[1] - p1[1]) - (p3[0] - p1[0]) * (p2[1] - p1[1]);
         let b = [p2[1] - p3[1], p3[1] - p1[1], p1[1] - p2[1]];
         let c = [p3[0] - p2[0], p1[0] - p3[0], p2[0] - p1[0]];
+        // A row of the pair (k, l) block is (row₀ bₗ + row₂ cₗ, row₁ cₗ + row₂ bₗ): over the
+        // three l at once, the alternating row entries times these, in vector lanes.
+        let bc = [b[0], c[0], b[1], c[1], b[2], c[2]];
+        let cb = [c[0], b[0], c[1], b[1], c[2], b[2]];
         let e = &self.elasticity;
         let scale = 1.0 / (2.0 * two_a);
+        let mut ke = [0.0; 36];
+        let mut fe = [0.0; 6];
         for k in 0..3 {
             // Bₖᵀ (2 × 3) times C, row by row.
             let rows = [
@@ -590,16 +588,17 @@ impl Connection {
                 ],
             ];
             let sigma = &self.stress;
-            force(2 * k, 0.5 * (b[k] * sigma[0] + c[k] * sigma[2]));
-            force(2 * k + 1, 0.5 * (c[k] * sigma[1] + b[k] * sigma[2]));
-            for l in 0..3 {
-                for (r, row) in rows.iter().enumerate() {
-                    let i = 2 * k + r;
-                    stiffness(i, 2 * l, scale * (row[0] * b[l] + row[2] * c[l]));
-                    stiffness(i, 2 * l + 1, scale * (row[1] * c[l] + row[2] * b[l]));
+            fe[2 * k] = 0.5 * (b[k] * sigma[0] + c[k] * sigma[2]);
+            fe[2 * k + 1] = 0.5 * (c[k] * sigma[1] + b[k] * sigma[2]);
+            for (r, row) in rows.iter().enumerate() {
+                let alternating = [row[0], row[1], row[0], row[1], row[0], row[1]];
+                let out = &mut ke[(2 * k + r) * 6..(2 * k + r + 1) * 6];
+                for j in 0..6 {
+                    out[j] = scale * (alternating[j] * bc[j] + row[2] * cb[j]);
                 }
             }
         }
+        (ke, fe)
     }
 
     /// Elastic energy, J: the work the element's forces (`fe`, `ke` of each step) did on
