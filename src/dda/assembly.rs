@@ -13,6 +13,7 @@ use nalgebra::DVector;
 use super::block::{Mat6, Vec6, t_transpose_at};
 use super::joints::{ElementTerms, MAX_NODES};
 use super::linear::{BlockMatrix, BlockPattern};
+use super::mat6::transpose;
 use crate::model::geometry::{self, Point};
 
 /// Maps blocks to unknowns and holds the known increments of prescribed blocks.
@@ -159,20 +160,8 @@ impl System {
         for (o, &(b, x)) in offsets.iter_mut().zip(nodes) {
             *o = geometry::sub(x, centroids[b]);
         }
-        // The distinct blocks of the nodes, and which of them carries each node.
-        let mut blocks = [0usize; MAX_NODES];
-        let mut group = [0usize; MAX_NODES];
-        let mut count = 0;
-        for (k, &(b, _)) in nodes.iter().enumerate() {
-            group[k] = match blocks[..count].iter().position(|&q| q == b) {
-                Some(g) => g,
-                None => {
-                    blocks[count] = b;
-                    count += 1;
-                    count - 1
-                }
-            };
-        }
+        let by_block = NodesByBlock::new(nodes);
+        let (blocks, count, group) = (&by_block.blocks, by_block.count, &by_block.group);
         // s[k][g][r] = row r of Σ over the nodes l on block g of ke_kl T_l (2×6), i.e.
         // Σ_l T_lᵀ (ke[2k+r][2l], ke[2k+r][2l+1]).
         let mut s = [[[[0.0; 6]; 2]; MAX_NODES]; MAX_NODES];
@@ -193,7 +182,7 @@ impl System {
                 continue;
             };
             // Start-of-step force.
-            for k in (0..n).filter(|&k| group[k] == gp) {
+            for &k in by_block.members(gp) {
                 let f = t_transpose_at(offsets[k], [fe[2 * k], fe[2 * k + 1]]);
                 for i in 0..6 {
                     self.r[sp + i] -= f[i];
@@ -205,17 +194,19 @@ impl System {
                 if dofs.slot[bq].is_some_and(|sq| sq < sp) {
                     continue;
                 }
-                // m = Σ over the nodes k on block p of T_kᵀ s[k][q] (6×6), column by column.
-                let mut m = [[0.0; 6]; 6];
-                for k in (0..n).filter(|&k| group[k] == gp) {
+                // m = Σ over the nodes k on block p of T_kᵀ s[k][q] (6×6), column by column
+                // (formed as the rows of its transpose: each column is six adjacent sums).
+                let mut m_t = [[0.0; 6]; 6];
+                for &k in by_block.members(gp) {
                     let skq = &s[k][gq];
-                    for j in 0..6 {
+                    for (j, m_tj) in m_t.iter_mut().enumerate() {
                         let column = t_transpose_at(offsets[k], [skq[0][j], skq[1][j]]);
-                        for i in 0..6 {
-                            m[i][j] += column[i];
+                        for (m_ij, c_i) in m_tj.iter_mut().zip(column) {
+                            *m_ij += c_i;
                         }
                     }
                 }
+                let m = transpose(&m_t);
                 match dofs.slot[bq] {
                     Some(sq) => self.k.add(sp / 6, sq / 6, &m, c),
                     None => {
@@ -227,6 +218,50 @@ impl System {
                 }
             }
         }
+    }
+}
+
+/// An element's nodes grouped by the block that carries them (first appearance order).
+struct NodesByBlock {
+    /// The distinct blocks.
+    blocks: [usize; MAX_NODES],
+    /// How many there are.
+    count: usize,
+    /// Which of them carries each node.
+    group: [usize; MAX_NODES],
+    /// The nodes each carries, in node order (the first `sizes[g]`).
+    members: [[usize; MAX_NODES]; MAX_NODES],
+    sizes: [usize; MAX_NODES],
+}
+
+impl NodesByBlock {
+    fn new(nodes: &[(usize, Point)]) -> Self {
+        let mut out = Self {
+            blocks: [0; MAX_NODES],
+            count: 0,
+            group: [0; MAX_NODES],
+            members: [[0; MAX_NODES]; MAX_NODES],
+            sizes: [0; MAX_NODES],
+        };
+        for (k, &(b, _)) in nodes.iter().enumerate() {
+            let g = match out.blocks[..out.count].iter().position(|&q| q == b) {
+                Some(g) => g,
+                None => {
+                    out.blocks[out.count] = b;
+                    out.count += 1;
+                    out.count - 1
+                }
+            };
+            out.group[k] = g;
+            out.members[g][out.sizes[g]] = k;
+            out.sizes[g] += 1;
+        }
+        out
+    }
+
+    /// The nodes on the `g`-th block.
+    fn members(&self, g: usize) -> &[usize] {
+        &self.members[g][..self.sizes[g]]
     }
 }
 
