@@ -110,12 +110,14 @@ impl ElementTerms {
     /// Node forces at the end of the step: fe + ke·u (the first 2n entries).
     pub fn end_forces(&self, u: &[Point]) -> [f64; 2 * MAX_NODES] {
         let dim = 2 * self.count;
+        let mut flat = [0.0; 2 * MAX_NODES];
+        for (pair, uk) in flat.chunks_exact_mut(2).zip(u) {
+            pair.copy_from_slice(uk);
+        }
         let mut out = [0.0; 2 * MAX_NODES];
-        for i in 0..dim {
-            out[i] = self.fe[i]
-                + (0..dim)
-                    .map(|j| self.ke[i * dim + j] * u[j / 2][j % 2])
-                    .sum::<f64>();
+        let rows = self.ke.chunks_exact(dim).take(dim);
+        for (i, (o, ke_row)) in out.iter_mut().zip(rows).enumerate() {
+            *o = self.fe[i] + ke_row.iter().zip(&flat).map(|(k, x)| k * x).sum::<f64>();
         }
         out
     }
