@@ -10,9 +10,10 @@ pub fn transpose(m: &Mat6) -> Mat6 {
 }
 
 /// The start of a sum, as `Iterator::sum` starts one: with −0.0, the neutral element of
-/// addition. [`divide_by_transposed`] sums six dot products side by side (so that the
-/// compiler can put them in vector lanes), each in the order `sum` would, from the same
-/// start: the results are those of one dot product after the other, to the bit.
+/// addition. [`cholesky`] and [`divide_by_transposed`] sum six dot products side by side
+/// (so that the compiler can put them in vector lanes), each in the order `sum` would,
+/// from the same start: the results are those of one dot product after the other, to the
+/// bit.
 const SUM_START: f64 = -0.0;
 
 /// s ← s − a bᵀ.
