@@ -473,8 +473,27 @@ pub struct Connection {
     /// Elastic energy stored, J: the work of the element's forces on its strain
     /// increments (see [`Connection::energy`]).
     pub stored_energy: f64,
-    /// Node positions of the unstressed element (its reference shape).
-    rest: [Point; 3],
+    /// The inverse of the unstressed element's edge matrix (its reference shape), which
+    /// every step's strain needs: computed once, the same values as at each step.
+    rest_inverse: [[f64; 2]; 2],
+}
+
+/// A triangle's edge matrix: the edges from its first node as columns.
+fn edges(n: &[Point; 3]) -> [[f64; 2]; 2] {
+    [
+        [n[1][0] - n[0][0], n[2][0] - n[0][0]],
+        [n[1][1] - n[0][1], n[2][1] - n[0][1]],
+    ]
+}
+
+/// The inverse of a triangle's edge matrix.
+fn inverse_edges(n: &[Point; 3]) -> [[f64; 2]; 2] {
+    let r = edges(n);
+    let det = r[0][0] * r[1][1] - r[0][1] * r[1][0];
+    [
+        [r[1][1] / det, -r[0][1] / det],
+        [-r[1][0] / det, r[0][0] / det],
+    ]
 }
 
 impl Connection {
@@ -487,7 +506,7 @@ impl Connection {
             strain: [0.0; 3],
             stress: [0.0; 3],
             stored_energy: 0.0,
-            rest: nodes,
+            rest_inverse: inverse_edges(&nodes),
         }
     }
 
@@ -496,18 +515,7 @@ impl Connection {
     /// decomposition `F = V R`. A rigid turn has no strain, and to first order a step
     /// changes it by the increment `B u` the step was solved with.
     fn geometric_strain(&self) -> [f64; 3] {
-        let edges = |n: &[Point; 3]| {
-            [
-                [n[1][0] - n[0][0], n[2][0] - n[0][0]],
-                [n[1][1] - n[0][1], n[2][1] - n[0][1]],
-            ]
-        };
-        let (x, r) = (edges(&self.nodes), edges(&self.rest));
-        let det = r[0][0] * r[1][1] - r[0][1] * r[1][0];
-        let r_inv = [
-            [r[1][1] / det, -r[0][1] / det],
-            [-r[1][0] / det, r[0][0] / det],
-        ];
+        let (x, r_inv) = (edges(&self.nodes), &self.rest_inverse);
         let mut f = [[0.0; 2]; 2];
         for i in 0..2 {
             for j in 0..2 {
