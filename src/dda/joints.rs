@@ -178,10 +178,7 @@ impl ConnectionGroups {
     /// Appends the terms of every group, at the connections' current geometry.
     pub fn terms_into(&self, connections: &[Connection], out: &mut Vec<ElementTerms>) {
         for g in &self.groups {
-            let nodes: [(usize, Point); MAX_NODES] = std::array::from_fn(|k| {
-                let (ci, node) = g.sources[k];
-                connections[ci].node_list()[node]
-            });
+            let nodes = g.nodes(connections);
             // Built in place: the terms are larger than the work of filling them.
             let index = out.len();
             out.push(ElementTerms::with_nodes(&nodes[..g.nodes]));
@@ -198,10 +195,10 @@ impl ConnectionGroups {
     /// triangles' copies of it stay equal to the bit, as they were when grouped.
     pub fn commit(&self, connections: &mut [Connection], motion: &impl NodeMotion) {
         for g in &self.groups {
+            let nodes = g.nodes(connections);
             let mut linear = [[0.0; 2]; MAX_NODES];
             let mut exact = [[0.0; 2]; MAX_NODES];
-            for (k, &(ci, node)) in g.sources[..g.nodes].iter().enumerate() {
-                let (b, x) = connections[ci].node_list()[node];
+            for (k, &(b, x)) in nodes[..g.nodes].iter().enumerate() {
                 linear[k] = motion.linear_node_displacement(b, x);
                 exact[k] = motion.node_displacement(b, x);
             }
@@ -220,6 +217,15 @@ impl ConnectionGroups {
 }
 
 impl ConnectionGroup {
+    /// The group's nodes (block, current position), read from the triangles that carry
+    /// them; the first `self.nodes` are the group's.
+    fn nodes(&self, connections: &[Connection]) -> [(usize, Point); MAX_NODES] {
+        std::array::from_fn(|k| {
+            let (ci, node) = self.sources[k];
+            connections[ci].node_list()[node]
+        })
+    }
+
     /// Adds connection `ci` (its `nodes`) when the group can take it.
     fn join(&mut self, connections: &[Connection], ci: usize, nodes: &[(usize, Point); 3]) -> bool {
         if self.len == MAX_NODES || ci != self.first + self.len {
@@ -733,6 +739,36 @@ mod tests {
                 "{:?}, shrink {shrink:e}",
                 e.strain
             );
+        }
+    }
+
+    /// A group moves its triangles as each triangle's own commit would, to the bit (its
+    /// shared nodes' displacements are computed once and handed round).
+    #[test]
+    fn a_group_commits_its_triangles_as_they_would_alone() {
+        let c = [[2.0e9, 0.5e9, 0.0], [0.5e9, 2.0e9, 0.0], [0.0, 0.0, 0.75e9]];
+        let n = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.1], [0.0, 0.1]];
+        let triangle = |k: [usize; 3]| Connection::new([3; 3], k.map(|i| n[i]), c);
+        let mut grouped = vec![
+            triangle([0, 1, 2]),
+            triangle([0, 2, 3]),
+            triangle([0, 1, 3]),
+            triangle([1, 2, 3]),
+        ];
+        let mut alone = grouped.clone();
+        let groups = ConnectionGroups::new(&grouped);
+        let (s, co) = 0.01_f64.sin_cos();
+        for step in [
+            Affine([[1.001, 2e-4], [-1e-4, 0.998]]),
+            Affine([[co, -s], [s, co]]),
+        ] {
+            groups.commit(&mut grouped, &step);
+            for t in &mut alone {
+                t.commit(&step);
+            }
+        }
+        for (g, a) in grouped.iter().zip(&alone) {
+            assert_eq!(format!("{g:?}"), format!("{a:?}"));
         }
     }
 
