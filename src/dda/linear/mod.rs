@@ -24,9 +24,11 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::SymbolicSparseColMatRef;
 
 use super::block::Mat6;
+pub(crate) use dense::DenseCholesky;
 use envelope::{Envelope, EnvelopeCholesky};
 use sparse::SparseCholesky;
 
+mod dense;
 mod envelope;
 mod sparse;
 
@@ -423,66 +425,68 @@ const SUPERNODAL_SPEEDUP: f64 = 3.0;
 /// fresh factorisation achieves.
 const BACKWARD_ERROR: f64 = 1e-14;
 
-/// Systems of up to four blocks (24 unknowns) are factorised with nalgebra's Cholesky at
-/// a size fixed at compile time (unrolled, on the stack): at this size the set-up of a
-/// blocked, vectorised factorisation costs more than the arithmetic.
+/// Systems of up to four blocks (24 unknowns) are factorised densely at a size fixed at
+/// compile time ([`DenseCholesky`], in place): at this size the set-up of a blocked,
+/// vectorised factorisation costs more than the arithmetic.
 pub(crate) const TINY_LIMIT: usize = 24;
-
-/// A Cholesky factor of a compile-time size.
-type TinyCholesky<const N: usize> = Option<nalgebra::Cholesky<f64, nalgebra::Const<N>>>;
 
 /// The factor of a system of one to four blocks (held inline: it is one allocation-free
 /// object per model, and the model keeps exactly one).
 #[allow(clippy::large_enum_variant)]
+#[derive(Clone)]
 enum Tiny {
-    B1(TinyCholesky<6>),
-    B2(TinyCholesky<12>),
-    B3(TinyCholesky<18>),
-    B4(TinyCholesky<24>),
+    B1(DenseCholesky<6>),
+    B2(DenseCholesky<12>),
+    B3(DenseCholesky<18>),
+    B4(DenseCholesky<24>),
 }
 
 impl Tiny {
     fn new(n: usize) -> Option<Self> {
         Some(match n {
-            6 => Tiny::B1(None),
-            12 => Tiny::B2(None),
-            18 => Tiny::B3(None),
-            24 => Tiny::B4(None),
+            6 => Tiny::B1(DenseCholesky::empty()),
+            12 => Tiny::B2(DenseCholesky::empty()),
+            18 => Tiny::B3(DenseCholesky::empty()),
+            24 => Tiny::B4(DenseCholesky::empty()),
             _ => return None,
         })
     }
 
-    fn factorize(&mut self, k: &BlockMatrix) -> Result<(), SolveError> {
-        fn factor<const N: usize>(
-            slot: &mut TinyCholesky<N>,
-            k: &BlockMatrix,
-        ) -> Result<(), SolveError> {
-            let mut m = nalgebra::SMatrix::<f64, N, N>::zeros();
-            k.for_each_lower(|row, col, v| m[(row, col)] = v);
-            *slot = Some(nalgebra::Cholesky::new(m).ok_or(SolveError::NotPositiveDefinite)?);
-            Ok(())
-        }
+    /// The same size, no factor.
+    fn empty_like(&self) -> Self {
         match self {
+            Tiny::B1(_) => Tiny::B1(DenseCholesky::empty()),
+            Tiny::B2(_) => Tiny::B2(DenseCholesky::empty()),
+            Tiny::B3(_) => Tiny::B3(DenseCholesky::empty()),
+            Tiny::B4(_) => Tiny::B4(DenseCholesky::empty()),
+        }
+    }
+
+    fn factorize(&mut self, k: &BlockMatrix) -> Result<(), SolveError> {
+        fn factor<const N: usize>(c: &mut DenseCholesky<N>, k: &BlockMatrix) -> bool {
+            c.clear();
+            k.for_each_lower(|row, column, value| c.set(row, column, value));
+            c.factorize()
+        }
+        let factored = match self {
             Tiny::B1(c) => factor(c, k),
             Tiny::B2(c) => factor(c, k),
             Tiny::B3(c) => factor(c, k),
             Tiny::B4(c) => factor(c, k),
+        };
+        if factored {
+            Ok(())
+        } else {
+            Err(SolveError::NotPositiveDefinite)
         }
     }
 
     fn solve(&self, x: &mut [f64]) {
-        fn solve<const N: usize>(slot: &TinyCholesky<N>, x: &mut [f64]) {
-            if let Some(c) = slot {
-                let mut v = nalgebra::SVector::<f64, N>::from_column_slice(x);
-                c.solve_mut(&mut v);
-                x.copy_from_slice(v.as_slice());
-            }
-        }
         match self {
-            Tiny::B1(c) => solve(c, x),
-            Tiny::B2(c) => solve(c, x),
-            Tiny::B3(c) => solve(c, x),
-            Tiny::B4(c) => solve(c, x),
+            Tiny::B1(c) => c.solve(x),
+            Tiny::B2(c) => c.solve(x),
+            Tiny::B3(c) => c.solve(x),
+            Tiny::B4(c) => c.solve(x),
         }
     }
 }
@@ -587,12 +591,7 @@ impl Factor {
     /// An empty factor of the same kind and size (sharing the symbolic analysis).
     fn empty_like(&self) -> Self {
         match self {
-            Factor::Tiny(t) => Factor::Tiny(match t {
-                Tiny::B1(_) => Tiny::B1(None),
-                Tiny::B2(_) => Tiny::B2(None),
-                Tiny::B3(_) => Tiny::B3(None),
-                Tiny::B4(_) => Tiny::B4(None),
-            }),
+            Factor::Tiny(t) => Factor::Tiny(t.empty_like()),
             Factor::Envelope(l) => Factor::Envelope(l.empty_like()),
             Factor::Sparse(l) => Factor::Sparse(l.empty_like()),
         }
@@ -928,17 +927,22 @@ pub(super) mod tests {
         springs(blocks, &ring, seed)
     }
 
-    /// A random-ish SPD block matrix with a spring on each of the block pairs `pairs`.
-    pub(super) fn springs(blocks: usize, pairs: &[(usize, usize)], seed: u64) -> BlockMatrix {
-        let pattern = Arc::new(BlockPattern::new(blocks, pairs.iter().copied()));
-        let mut k = BlockMatrix::zeros(pattern);
+    /// Reproducible numbers in [−0.5, 0.5) (a linear congruential generator).
+    pub(super) fn pseudo_random(seed: u64) -> impl FnMut() -> f64 {
         let mut s = seed;
-        let mut next = || {
+        move || {
             s = s
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        }
+    }
+
+    /// A random-ish SPD block matrix with a spring on each of the block pairs `pairs`.
+    pub(super) fn springs(blocks: usize, pairs: &[(usize, usize)], seed: u64) -> BlockMatrix {
+        let pattern = Arc::new(BlockPattern::new(blocks, pairs.iter().copied()));
+        let mut k = BlockMatrix::zeros(pattern);
+        let mut next = pseudo_random(seed);
         // A diagonal mass plus springs between the pairs (u uᵀ on the pair): SPD.
         for i in 0..blocks {
             let mut m = [[0.0; 6]; 6];

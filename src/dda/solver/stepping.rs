@@ -2,6 +2,7 @@
 
 use super::iteration::yield_stretch;
 use super::*;
+use crate::dda::linear::DenseCholesky;
 
 impl Dda {
     /// Largest vertex displacement of the structure relative to the ground translation,
@@ -842,20 +843,25 @@ impl Dda {
             }
             // A rigid block's strain accelerations stay zero: its strain rows are held.
             let n = if b.rigid { 3 } else { 6 };
-            let mut m = nalgebra::Matrix6::<f64>::identity();
-            let mut r = nalgebra::Vector6::<f64>::zeros();
+            let mut x = [0.0; 6];
             for i in 0..n {
-                r[i] = inertia[i] + f1[i] - f0[i];
-                for j in 0..n {
-                    m[(i, j)] = b.mass[i][j];
+                x[i] = inertia[i] + f1[i] - f0[i];
+            }
+            // The mass on the rows that move, the identity on the held ones.
+            let mut mass = DenseCholesky::<6>::empty();
+            for j in 0..6 {
+                mass.set(j, j, if j < n { b.mass[j][j] } else { 1.0 });
+                for i in j + 1..n {
+                    mass.set(i, j, b.mass[i][j]);
                 }
             }
-            let Some(chol) = m.cholesky() else { continue };
-            let x = chol.solve(&r);
-            for i in 0..n {
-                let shift = x[i] - b.response_accel[i];
-                b.accel[i] += shift;
-                b.response_accel[i] = x[i];
+            if !mass.factorize() {
+                continue;
+            }
+            mass.solve(&mut x);
+            for (i, &xi) in x.iter().enumerate().take(n) {
+                b.accel[i] += xi - b.response_accel[i];
+                b.response_accel[i] = xi;
             }
         }
     }
