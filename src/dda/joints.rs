@@ -202,16 +202,17 @@ impl ConnectionGroups {
                 linear[k] = motion.linear_node_displacement(b, x);
                 exact[k] = motion.node_displacement(b, x);
             }
-            for (map, c) in g
-                .maps
-                .iter()
-                .zip(&mut connections[g.first..g.first + g.len])
-            {
-                c.commit_displaced(
+            let triangles = &mut connections[g.first..g.first + g.len];
+            // In two passes over the group rather than triangle by triangle: each half's
+            // divisions and roots then wait for nothing from the other triangles', and
+            // the processor overlaps them (the same operations on each triangle).
+            for (map, c) in g.maps.iter().zip(triangles.iter_mut()) {
+                c.book_and_move(
                     std::array::from_fn(|k| linear[map[k]]),
                     std::array::from_fn(|k| exact[map[k]]),
                 );
             }
+            triangles.iter_mut().for_each(Connection::take_new_shape);
         }
     }
 }
@@ -644,6 +645,13 @@ impl Connection {
     /// [`Connection::commit`] with the nodes' displacements given: `lin` under the
     /// linear map the step was solved with, `u` as the nodes move.
     fn commit_displaced(&mut self, lin: [Point; 3], u: [Point; 3]) {
+        self.book_and_move(lin, u);
+        self.take_new_shape();
+    }
+
+    /// The first half of a commit: books the work of the step on the element and moves
+    /// its nodes by `u` (its long-latency part is the B matrix's six divisions).
+    fn book_and_move(&mut self, lin: [Point; 3], u: [Point; 3]) {
         let (area, b) = self.b_matrix();
         // The strain increment from the linear node displacements the step was solved
         // with, so that the element stores the work the solve did on it. The exact ones
@@ -666,6 +674,11 @@ impl Connection {
             p[0] += d[0];
             p[1] += d[1];
         }
+    }
+
+    /// The second half of a commit: the strain and stress of the shape the nodes now
+    /// have (its long-latency part is the polar rotation's root and divisions).
+    fn take_new_shape(&mut self) {
         self.strain = self.geometric_strain();
         for i in 0..3 {
             self.stress[i] = (0..3)
