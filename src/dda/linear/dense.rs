@@ -15,6 +15,11 @@ pub(crate) struct DenseCholesky<const N: usize> {
     columns: [[f64; N]; N],
     /// Whether `columns` holds a factor (the last factorisation succeeded).
     ready: bool,
+    /// The unknowns held at zero: a row and column of the identity (a rigid block's
+    /// strains, see `BlockMatrix::hold_strains`). Their factor column is the identity's,
+    /// and what they add to the others' is zero, so both are skipped: for the two-block
+    /// model's two rigid blocks, half the unknowns and three quarters of the work.
+    held: [bool; N],
 }
 
 impl<const N: usize> DenseCholesky<N> {
@@ -23,6 +28,7 @@ impl<const N: usize> DenseCholesky<N> {
         Self {
             columns: [[0.0; N]; N],
             ready: false,
+            held: [false; N],
         }
     }
 
@@ -45,16 +51,51 @@ impl<const N: usize> DenseCholesky<N> {
     /// Factorises the matrix written since [`DenseCholesky::clear`], in place. False
     /// (and no factor held) if it is not positive definite.
     pub(crate) fn factorize(&mut self) -> bool {
+        self.held = self.identity_rows();
         self.ready = self.factorize_in_place();
         self.ready
     }
 
+    /// [`DenseCholesky::factorize`] for a matrix whose rows and columns `held` are the
+    /// identity's by construction (the caller wrote them so).
+    pub(crate) fn factorize_holding(&mut self, held: [bool; N]) -> bool {
+        debug_assert!(
+            held.iter()
+                .zip(self.identity_rows())
+                .all(|(&h, is)| !h || is),
+            "a held unknown's row and column are the identity's"
+        );
+        self.held = held;
+        self.ready = self.factorize_in_place();
+        self.ready
+    }
+
+    /// Marks the unknowns whose row and column are the identity's (a diagonal of
+    /// exactly one is rare enough to look at the rest only then).
+    fn identity_rows(&self) -> [bool; N] {
+        let c = &self.columns;
+        std::array::from_fn(|j| {
+            c[j][j] == 1.0
+                && c[j][j + 1..].iter().all(|&v| v == 0.0)
+                && (0..j).all(|k| c[k][j] == 0.0)
+        })
+    }
+
     /// nalgebra's `Cholesky::new_internal`: column `j` less `L[j][k]` times column `k`
     /// (as `(−L[j][k]) · L[i][k] + a[i][j]`), then divided by the root of its pivot.
+    /// A held unknown's column is left as it is (its root is 1, its entries 0), and its
+    /// update of another column is skipped: it would add `±0` to each entry (which can
+    /// only turn a `−0.0` into a `+0.0`).
     fn factorize_in_place(&mut self) -> bool {
-        let c = &mut self.columns;
+        let (c, held) = (&mut self.columns, &self.held);
         for j in 0..N {
+            if held[j] {
+                continue;
+            }
             for k in 0..j {
+                if held[k] {
+                    continue;
+                }
                 let factor = -c[k][j];
                 let (done, rest) = c.split_at_mut(j);
                 let (column_k, column_j) = (&done[k], &mut rest[0]);
@@ -79,13 +120,18 @@ impl<const N: usize> DenseCholesky<N> {
 
     /// x ← (L Lᵀ)⁻¹ x (nothing if no factor is held): nalgebra's
     /// `solve_lower_triangular_unchecked_mut` then `ad_solve_lower_triangular_unchecked_mut`.
+    /// A held unknown's rows are skipped: its value is its right-hand side's, and it
+    /// adds `±0` to the others'.
     pub(crate) fn solve(&self, x: &mut [f64]) {
         if !self.ready {
             return;
         }
-        let c = &self.columns;
+        let (c, held) = (&self.columns, &self.held);
         let x = &mut x[..N];
         for i in 0..N {
+            if held[i] {
+                continue;
+            }
             let coefficient = x[i] / c[i][i];
             x[i] = coefficient;
             for r in i + 1..N {
@@ -93,6 +139,9 @@ impl<const N: usize> DenseCholesky<N> {
             }
         }
         for i in (0..N).rev() {
+            if held[i] {
+                continue;
+            }
             let dot = unrolled_dot(&c[i][i + 1..], &x[i + 1..]);
             x[i] = (x[i] - dot) / c[i][i];
         }
@@ -162,6 +211,55 @@ mod tests {
             let expected = theirs.solve(&rhs);
             for i in 0..N {
                 assert_eq!(x[i].to_bits(), expected[i].to_bits(), "x[{i}]");
+            }
+        }
+    }
+
+    /// Held unknowns (identity rows and columns, as two rigid blocks' strains) are
+    /// skipped, and the factor and solution are still nalgebra's: the same bits but for
+    /// the sign of an exact zero.
+    #[test]
+    fn held_unknowns_are_skipped_with_the_same_result() {
+        const N: usize = 12;
+        let held = |i: usize| (3..6).contains(&i) || (9..12).contains(&i);
+        for seed in 1..6 {
+            let mut m = spd::<N>(seed);
+            for i in (0..N).filter(|&i| held(i)) {
+                for j in 0..N {
+                    m[(i, j)] = 0.0;
+                    m[(j, i)] = 0.0;
+                }
+                m[(i, i)] = 1.0;
+            }
+            let mut ours = DenseCholesky::<N>::empty();
+            ours.clear();
+            for j in 0..N {
+                for i in j..N {
+                    ours.set(i, j, m[(i, j)]);
+                }
+            }
+            assert!(ours.factorize());
+            assert_eq!(ours.held.iter().filter(|&&h| h).count(), 6);
+            let theirs = m.cholesky().expect("SPD");
+            let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
+            let l = theirs.l_dirty();
+            for j in 0..N {
+                for i in j..N {
+                    assert!(same(ours.columns[j][i], l[(i, j)]), "L[{i}][{j}]");
+                }
+            }
+            let rhs = nalgebra::SVector::<f64, N>::from_fn(|i, _| {
+                if held(i) {
+                    0.0
+                } else {
+                    (i as f64 * 0.37).sin() - 0.2
+                }
+            });
+            let mut x = rhs.as_slice().to_vec();
+            ours.solve(&mut x);
+            let expected = theirs.solve(&rhs);
+            for i in 0..N {
+                assert!(same(x[i], expected[i]), "x[{i}]");
             }
         }
     }

@@ -855,7 +855,7 @@ impl Dda {
                     mass.set(i, j, b.mass[i][j]);
                 }
             }
-            if !mass.factorize() {
+            if !mass.factorize_holding(std::array::from_fn(|j| j >= n)) {
                 continue;
             }
             mass.solve(&mut x);
