@@ -181,37 +181,43 @@ mod tests {
         a * a.transpose() + nalgebra::SMatrix::<f64, N, N>::identity() * 0.1
     }
 
+    /// Factorises and solves `m` (with `rhs`) both ours and nalgebra's way and checks
+    /// every entry of the factor and the solution with `same`.
+    fn compare_with_nalgebra<const N: usize>(
+        m: &nalgebra::SMatrix<f64, N, N>,
+        rhs: &nalgebra::SVector<f64, N>,
+        same: impl Fn(f64, f64) -> bool,
+    ) -> DenseCholesky<N> {
+        let mut ours = DenseCholesky::<N>::empty();
+        ours.clear();
+        for j in 0..N {
+            for i in j..N {
+                ours.set(i, j, m[(i, j)]);
+            }
+        }
+        assert!(ours.factorize());
+        let theirs = m.cholesky().expect("SPD");
+        let l = theirs.l_dirty();
+        for j in 0..N {
+            for i in j..N {
+                assert!(same(ours.columns[j][i], l[(i, j)]), "L[{i}][{j}]");
+            }
+        }
+        let mut x = rhs.as_slice().to_vec();
+        ours.solve(&mut x);
+        let expected = theirs.solve(rhs);
+        for i in 0..N {
+            assert!(same(x[i], expected[i]), "x[{i}]");
+        }
+        ours
+    }
+
     /// The factor and the solution are nalgebra's to the bit, at every size the solver
     /// uses (6 to 24), with right-hand sides that exercise the unrolled dot's chunks.
     fn same_bits_as_nalgebra<const N: usize>() {
         for seed in 1..6 {
-            let m = spd::<N>(seed);
-            let mut ours = DenseCholesky::<N>::empty();
-            ours.clear();
-            for j in 0..N {
-                for i in j..N {
-                    ours.set(i, j, m[(i, j)]);
-                }
-            }
-            assert!(ours.factorize());
-            let theirs = m.cholesky().expect("SPD");
-            let l = theirs.l_dirty();
-            for j in 0..N {
-                for i in j..N {
-                    assert_eq!(
-                        ours.columns[j][i].to_bits(),
-                        l[(i, j)].to_bits(),
-                        "L[{i}][{j}]"
-                    );
-                }
-            }
             let rhs = nalgebra::SVector::<f64, N>::from_fn(|i, _| (i as f64 * 0.37).sin() - 0.2);
-            let mut x = rhs.as_slice().to_vec();
-            ours.solve(&mut x);
-            let expected = theirs.solve(&rhs);
-            for i in 0..N {
-                assert_eq!(x[i].to_bits(), expected[i].to_bits(), "x[{i}]");
-            }
+            compare_with_nalgebra(&spd::<N>(seed), &rhs, |a, b| a.to_bits() == b.to_bits());
         }
     }
 
@@ -231,23 +237,6 @@ mod tests {
                 }
                 m[(i, i)] = 1.0;
             }
-            let mut ours = DenseCholesky::<N>::empty();
-            ours.clear();
-            for j in 0..N {
-                for i in j..N {
-                    ours.set(i, j, m[(i, j)]);
-                }
-            }
-            assert!(ours.factorize());
-            assert_eq!(ours.held.iter().filter(|&&h| h).count(), 6);
-            let theirs = m.cholesky().expect("SPD");
-            let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
-            let l = theirs.l_dirty();
-            for j in 0..N {
-                for i in j..N {
-                    assert!(same(ours.columns[j][i], l[(i, j)]), "L[{i}][{j}]");
-                }
-            }
             let rhs = nalgebra::SVector::<f64, N>::from_fn(|i, _| {
                 if held(i) {
                     0.0
@@ -255,12 +244,9 @@ mod tests {
                     (i as f64 * 0.37).sin() - 0.2
                 }
             });
-            let mut x = rhs.as_slice().to_vec();
-            ours.solve(&mut x);
-            let expected = theirs.solve(&rhs);
-            for i in 0..N {
-                assert!(same(x[i], expected[i]), "x[{i}]");
-            }
+            let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
+            let ours = compare_with_nalgebra(&m, &rhs, same);
+            assert_eq!(ours.held.iter().filter(|&&h| h).count(), 6);
         }
     }
 
