@@ -70,8 +70,8 @@ impl<const N: usize> DenseCholesky<N> {
         self.ready
     }
 
-    /// Marks the unknowns whose row and column are the identity's (a diagonal of
-    /// exactly one is rare enough to look at the rest only then).
+    /// Which unknowns have the identity's row and column (the rest of a row and column
+    /// is looked at only where the diagonal is exactly one, which is rare otherwise).
     fn identity_rows(&self) -> [bool; N] {
         let c = &self.columns;
         std::array::from_fn(|j| {
