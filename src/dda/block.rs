@@ -366,13 +366,7 @@ impl Block {
 
     /// Kinetic energy `½ vᵀ M v`, J per unit thickness.
     pub fn kinetic_energy(&self) -> f64 {
-        let mut w = 0.0;
-        for i in 0..6 {
-            for j in 0..6 {
-                w += self.velocity[i] * self.mass[i][j] * self.velocity[j];
-            }
-        }
-        0.5 * w
+        0.5 * super::mat6::quadratic_form(&self.mass, &self.velocity, &self.velocity)
     }
 
     /// A free block of unit density and stiffness (the geometry tests' block).

@@ -250,17 +250,6 @@ pub struct Dda {
     initial_accel_pending: bool,
 }
 
-/// xᵀ M y for a block's 6×6 matrix.
-fn quadratic(m: &super::block::Mat6, x: &Vec6, y: &Vec6) -> f64 {
-    let mut sum = 0.0;
-    for i in 0..6 {
-        for j in 0..6 {
-            sum += x[i] * m[i][j] * y[j];
-        }
-    }
-    sum
-}
-
 /// Which state of the blocks a projection acts on.
 #[derive(Clone, Copy)]
 enum Field {

@@ -3,6 +3,7 @@
 use super::iteration::yield_stretch;
 use super::*;
 use crate::dda::linear::DenseCholesky;
+use crate::dda::mat6::quadratic_form;
 
 impl Dda {
     /// Largest vertex displacement of the structure relative to the ground translation,
@@ -539,9 +540,9 @@ impl Dda {
             for k in 0..6 {
                 a_mean[k] = 0.5 * (a0[k] + b.response_accel[k]);
             }
-            numerical += quadratic(&b.mass, &a_mean, d)
-                - 0.5 * quadratic(&b.mass, &b.velocity, &b.velocity)
-                + 0.5 * quadratic(&b.mass, v0, v0);
+            numerical += quadratic_form(&b.mass, &a_mean, d)
+                - 0.5 * quadratic_form(&b.mass, &b.velocity, &b.velocity)
+                + 0.5 * quadratic_form(&b.mass, v0, v0);
         }
         // Friction and contact counts.
         let augmented = self.augmented();
