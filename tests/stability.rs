@@ -97,10 +97,15 @@ fn long_run_energy_does_not_drift() {
 /// by the model, and every term of the balance is booked, so each run's residual must be
 /// far below its smallest dissipation (friction, at least 1.2e-2 of the energy through
 /// the run; impacts 0.6–0.98): a missed term in any step of substance would show. Gains
-/// are bounded at 1e-5 with the trapezoidal rule (it creates no energy of its own) and
-/// 1e-4 with the default, losses at 1e-3. Before the landing of every fresh impact, the
-/// classic step for contacts that open and the consistent friction forces, 14
-/// trapezoidal runs gained more than 1 % (worst 88 %: the block was thrown into a spin
+/// are bounded at 1e-5, losses at 1e-3. The trapezoidal rule creates no energy of its
+/// own, so its scheme's term (what its impact and restart steps remove) may not be
+/// negative either: it was in 22 of the 36 runs (down to −4.5e-3 of the input) while a
+/// loaded contact that opened was redone with the classic scheme, whose term has no
+/// sign; such a step now drops the contact's start force instead. The default's gains
+/// were bounded at 1e-4 (−3.1e-5 at 0.75 g, 0.8 ms) until a resolved event carried on
+/// the friction its accelerations were projected with. Before the landing of every
+/// fresh impact, the classic step for contacts that open and the consistent friction
+/// forces, 14 trapezoidal runs gained more than 1 % (worst 88 %: the block was thrown into a spin
 /// of five turns); before the tangential force of contacts that open was booked (a
 /// corner sliding under 2e6 N lifting off within a step), the worst gain was 1.1 % and
 /// losses reached 4.5 %. Every run must finish (before an open contact closed at any
@@ -127,14 +132,16 @@ fn a_toppling_block_gains_no_energy() {
                     }
                 };
                 let residual = dda.energy_residual_relative();
-                let largest_gain = match integrator {
-                    Integrator::Trapezoidal => 1e-5,
-                    _ => 1e-4,
-                };
                 assert!(
-                    (-largest_gain..1e-3).contains(&residual),
+                    (-1e-5..1e-3).contains(&residual),
                     "{run}: energy residual {residual:+.3e}"
                 );
+                let energy = dda.energy();
+                if integrator == Integrator::Trapezoidal {
+                    // Round-off of the exact zero of its ordinary steps aside.
+                    let scheme = energy.numerical_dissipated / energy.scale();
+                    assert!(scheme >= -1e-12, "{run}: the scheme's term {scheme:+.3e}");
+                }
                 let block = &dda.blocks()[dda.block_index("block").unwrap()];
                 assert!(
                     (block.rotation.abs() - std::f64::consts::FRAC_PI_2).abs() < 0.02,

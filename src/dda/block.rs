@@ -364,6 +364,12 @@ impl Block {
         self.elastic_energy
     }
 
+    /// The unknowns that move: a rigid block's translation and rotation (its strains
+    /// are held at zero), all six of a deformable one's.
+    pub fn moving_unknowns(&self) -> usize {
+        if self.rigid { 3 } else { 6 }
+    }
+
     /// Kinetic energy `½ vᵀ M v`, J per unit thickness.
     pub fn kinetic_energy(&self) -> f64 {
         0.5 * super::mat6::quadratic_form(&self.mass, &self.velocity, &self.velocity)
