@@ -147,6 +147,12 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// Whether the contact started the step closed and carrying a force, and its trial
+    /// state opens it.
+    pub fn opens_under_load(&self) -> bool {
+        self.start_state.is_closed() && self.start_normal > 0.0 && !self.state.is_closed()
+    }
+
     /// Gap at the end of the step for unknowns `di`, `dj`.
     pub fn gap_end(&self, di: &Vec6, dj: &Vec6) -> f64 {
         self.gap0 + dot6(&self.gap_i, di) + dot6(&self.gap_j, dj)
