@@ -68,21 +68,30 @@ impl Dda {
                 [b.velocity, b.accel, b.response_accel] = *saved;
             }
             // Friction that changes at the event (a slip that reverses, a stick that
-            // breaks at a force other than ρN) changes the accelerations as well.
+            // breaks at a force other than ρN) changes the accelerations as well; so does
+            // a contact that this resolution opened, whose forces before the event the
+            // accelerations still hold (the projection only acts on the constraints that
+            // stay). Left there, they were applied in the next step by the scheme but
+            // booked by no one: a toppling block's corner opened at 4.6e4 N, and the
+            // block lost 2.1 J in the next step's free flight.
             let mut friction_change = vec![0.0; self.dofs.n];
             for (c, &old) in self.contacts.iter().zip(&forces_before) {
-                if let ContactState::Sliding { direction } = c.start_state {
-                    let mu = c.props.friction.sliding_coefficient(c.start_slip_velocity);
-                    let change = -direction * mu * c.start_normal - old;
-                    spread_force(
-                        &self.dofs,
-                        &mut friction_change,
-                        change,
-                        [
-                            (c.key.vertex_block, &c.slip_i),
-                            (c.key.edge_block, &c.slip_j),
-                        ],
-                    );
+                let slip = [
+                    (c.key.vertex_block, &c.slip_i),
+                    (c.key.edge_block, &c.slip_j),
+                ];
+                match c.start_state {
+                    ContactState::Sliding { direction } => {
+                        let mu = c.props.friction.sliding_coefficient(c.start_slip_velocity);
+                        let change = -direction * mu * c.start_normal - old;
+                        spread_force(&self.dofs, &mut friction_change, change, slip);
+                    }
+                    ContactState::Open => {
+                        spread_force(&self.dofs, &mut friction_change, -old, slip);
+                        let gap = [(c.key.vertex_block, &c.gap_i), (c.key.edge_block, &c.gap_j)];
+                        spread_force(&self.dofs, &mut friction_change, -c.start_normal, gap);
+                    }
+                    _ => {}
                 }
             }
             if self.initial_accel_pending {
