@@ -153,6 +153,20 @@ impl Contact {
         self.start_state.is_closed() && self.start_normal > 0.0 && !self.state.is_closed()
     }
 
+    /// Adds to `out` (per block) the generalised forces of a normal force `normal`
+    /// (pushing apart) and a shear force `shear` (on the vertex along t̂) at this
+    /// contact, along its gradients.
+    pub fn add_forces(&self, normal: f64, shear: f64, out: &mut [Vec6]) {
+        for (b, gap, slip) in [
+            (self.key.vertex_block, &self.gap_i, &self.slip_i),
+            (self.key.edge_block, &self.gap_j, &self.slip_j),
+        ] {
+            for k in 0..6 {
+                out[b][k] += normal * gap[k] + shear * slip[k];
+            }
+        }
+    }
+
     /// Gap at the end of the step for unknowns `di`, `dj`.
     pub fn gap_end(&self, di: &Vec6, dj: &Vec6) -> f64 {
         self.gap0 + dot6(&self.gap_i, di) + dot6(&self.gap_j, dj)

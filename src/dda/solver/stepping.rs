@@ -455,6 +455,10 @@ impl Dda {
     /// the motion. The cost is the timing of the opening: the force is dropped at the
     /// step's start instead of somewhere in it, O(Δt) as with the classic scheme.
     fn release_opening_contacts(&mut self) -> Option<Released> {
+        let releasable = |c: &Contact| c.opens_under_load() && self.memory.contains_key(&c.key);
+        if !self.contacts.iter().any(releasable) {
+            return None;
+        }
         let before = Released {
             accelerations: self
                 .blocks
@@ -464,7 +468,6 @@ impl Dda {
             memory: self.memory.clone(),
         };
         let mut released: PerBlock<Vec6> = PerBlock::from_elem([0.0; 6], self.blocks.len());
-        let mut any = false;
         for c in &self.contacts {
             if !c.opens_under_load() {
                 continue;
@@ -472,20 +475,11 @@ impl Dda {
             let Some(m) = self.memory.get_mut(&c.key) else {
                 continue;
             };
-            any = true;
-            let (normal, shear) = (m.normal_force, m.shear_multiplier);
+            c.add_forces(m.normal_force, m.shear_multiplier, &mut released);
             m.normal_force = 0.0;
             m.shear_multiplier = 0.0;
             m.normal_change = 0.0;
             m.shear_change = 0.0;
-            for (b, gap, slip) in [
-                (c.key.vertex_block, &c.gap_i, &c.slip_i),
-                (c.key.edge_block, &c.gap_j, &c.slip_j),
-            ] {
-                for k in 0..6 {
-                    released[b][k] += normal * gap[k] + shear * slip[k];
-                }
-            }
         }
         for (b, f) in self.blocks.iter_mut().zip(&released) {
             if b.role == BlockRole::PrescribedGround || f.iter().all(|&x| x == 0.0) {
@@ -498,9 +492,6 @@ impl Dda {
                 b.accel[k] -= x[k];
                 b.response_accel[k] -= x[k];
             }
-        }
-        if !any {
-            return None;
         }
         self.forget_next_step_detection();
         Some(before)
@@ -906,16 +897,8 @@ impl Dda {
             if !m.state.is_closed() {
                 continue;
             }
-            let normal = m.normal_force;
             let shear = m.shear_multiplier - c.props.shear_penalty * m.shear;
-            for (b, gap, slip) in [
-                (c.key.vertex_block, &c.gap_i, &c.slip_i),
-                (c.key.edge_block, &c.gap_j, &c.slip_j),
-            ] {
-                for k in 0..6 {
-                    out[b][k] += normal * gap[k] + shear * slip[k];
-                }
-            }
+            c.add_forces(m.normal_force, shear, out);
         }
     }
 
