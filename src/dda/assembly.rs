@@ -109,6 +109,21 @@ impl System {
         known: &[Vec6],
         k: f64,
         f0: f64,
+        a: (usize, &Vec6),
+        b: Option<(usize, &Vec6)>,
+    ) {
+        self.add_scalar_spring_rhs(dofs, known, k, f0, a, b);
+        self.add_scalar_spring_matrix(dofs, k, a, b);
+    }
+
+    /// The right-hand side part of [`System::add_scalar_spring`] alone: for a spring
+    /// whose matrix part is already in (a new start force on the same springs).
+    pub fn add_scalar_spring_rhs(
+        &mut self,
+        dofs: &DofMap,
+        known: &[Vec6],
+        k: f64,
+        f0: f64,
         (bi, a): (usize, &Vec6),
         other: Option<(usize, &Vec6)>,
     ) {
@@ -120,17 +135,33 @@ impl System {
             for (ri, vi) in self.r.as_mut_slice()[sp..sp + 6].iter_mut().zip(vp) {
                 *ri -= f0 * vi;
             }
-            for qpart in parts.iter() {
-                let Some((bq, vq)) = *qpart else { continue };
-                match dofs.slot[bq] {
-                    Some(sq) => self.k.add_outer(sp / 6, sq / 6, vp, vq, c),
-                    None => {
-                        // Known increment: the coupling goes to the right-hand side.
-                        let q_known: f64 = (0..6).map(|j| vq[j] * known[bq][j]).sum();
-                        for i in 0..6 {
-                            self.r[sp + i] -= c * vp[i] * q_known;
-                        }
+            // Known increments: their couplings go to the right-hand side.
+            for &(bq, vq) in parts.iter().flatten() {
+                if dofs.slot[bq].is_none() {
+                    let q_known: f64 = (0..6).map(|j| vq[j] * known[bq][j]).sum();
+                    for i in 0..6 {
+                        self.r[sp + i] -= c * vp[i] * q_known;
                     }
+                }
+            }
+        }
+    }
+
+    /// The matrix part of [`System::add_scalar_spring`]: `c k a aᵀ` on the unknowns.
+    pub fn add_scalar_spring_matrix(
+        &mut self,
+        dofs: &DofMap,
+        k: f64,
+        (bi, a): (usize, &Vec6),
+        other: Option<(usize, &Vec6)>,
+    ) {
+        let c = self.stiffness_factor * k;
+        let parts: [Option<(usize, &Vec6)>; 2] = [Some((bi, a)), other];
+        for &(bp, vp) in parts.iter().flatten() {
+            let Some(sp) = dofs.slot[bp] else { continue };
+            for &(bq, vq) in parts.iter().flatten() {
+                if let Some(sq) = dofs.slot[bq] {
+                    self.k.add_outer(sp / 6, sq / 6, vp, vq, c);
                 }
             }
         }

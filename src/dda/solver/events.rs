@@ -232,36 +232,32 @@ impl Dda {
         let momentum = base.r.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
         // The last solve's field, and whether its updates met the tolerances.
         let mut last: Option<(PerBlock<Vec6>, bool)> = None;
-        for _ in 0..200 {
-            let mut sys = base.clone();
+        // The constraints' matrix is the same in every update; only the multipliers on
+        // the right-hand side change.
+        let mut sys = base.clone();
+        for c in self.contacts.iter() {
+            let p = c.props.normal_penalty / mass_factor;
+            for (i, j) in projected_rates(c) {
+                sys.add_scalar_spring_matrix(&self.dofs, p, i, Some(j));
+            }
+        }
+        self.hold_rigid_strains(&mut sys);
+        for update in 0..200 {
+            sys.r.copy_from(&base.r);
             for (c, m) in self.contacts.iter().zip(&multipliers) {
                 let p = c.props.normal_penalty / mass_factor;
-                let (i, j) = (c.key.vertex_block, c.key.edge_block);
-                if c.start_state.is_closed() {
-                    sys.add_scalar_spring(
-                        &self.dofs,
-                        &still,
-                        p,
-                        -m[0],
-                        (i, &c.gap_i),
-                        Some((j, &c.gap_j)),
-                    );
-                }
-                if c.start_state == ContactState::Locked {
-                    sys.add_scalar_spring(
-                        &self.dofs,
-                        &still,
-                        p,
-                        -m[1],
-                        (i, &c.slip_i),
-                        Some((j, &c.slip_j)),
-                    );
+                for ((i, j), m) in projected_rates(c).zip(m) {
+                    sys.add_scalar_spring_rhs(&self.dofs, &still, p, -m, i, Some(j));
                 }
             }
             self.hold_rigid_strains(&mut sys);
-            self.linear
-                .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
-                .map_err(|e| self.solve_error(e))?;
+            let solved = if update == 0 {
+                self.linear
+                    .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
+            } else {
+                (self.linear).solve_unchanged(&sys.k, sys.r.as_slice(), key, &mut solution)
+            };
+            solved.map_err(|e| self.solve_error(e))?;
             let x = self.increments(&solution, &still);
             let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
             for (c, m) in self.contacts.iter().zip(multipliers.iter_mut()) {
@@ -315,4 +311,17 @@ impl Dda {
         }
         Ok(multipliers)
     }
+}
+
+/// The constraint rates an event projection holds at zero for a contact, as (vertex
+/// block, gradient) and (edge block, gradient) pairs: the gap's while it is closed, then
+/// the slip's while it is locked (the order of its multipliers).
+fn projected_rates(c: &Contact) -> impl Iterator<Item = ((usize, &Vec6), (usize, &Vec6))> {
+    let (i, j) = (c.key.vertex_block, c.key.edge_block);
+    let normal = c
+        .start_state
+        .is_closed()
+        .then_some(((i, &c.gap_i), (j, &c.gap_j)));
+    let shear = (c.start_state == ContactState::Locked).then_some(((i, &c.slip_i), (j, &c.slip_j)));
+    normal.into_iter().chain(shear)
 }
