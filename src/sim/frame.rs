@@ -146,6 +146,25 @@ impl Samples {
         self.drift.append(&mut other.drift);
     }
 
+    /// Appends copies of the rows `rows` of `other`.
+    pub fn push_rows(&mut self, other: &Samples, rows: std::ops::Range<usize>) {
+        let columns = [
+            (&mut self.time, &other.time),
+            (&mut self.ground_accel, &other.ground_accel),
+            (
+                &mut self.ground_vertical_accel,
+                &other.ground_vertical_accel,
+            ),
+            (&mut self.base_accel, &other.base_accel),
+            (&mut self.roof_accel, &other.roof_accel),
+            (&mut self.slip, &other.slip),
+            (&mut self.drift, &other.drift),
+        ];
+        for (to, from) in columns {
+            to.extend_from_slice(&from[rows.clone()]);
+        }
+    }
+
     /// Number of rows with time ≤ `t`.
     pub fn count_until(&self, t: f64) -> usize {
         self.time.partition_point(|&s| s <= t + 1e-9)

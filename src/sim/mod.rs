@@ -7,7 +7,9 @@
 //! keep them all and scrub the timeline.
 
 pub mod frame;
+pub mod replay;
 
+use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -124,6 +126,8 @@ pub struct PreparedRun {
     /// What the user should know about the run (e.g. a time step that barely resolves the
     /// excitation), from the shared set-up's checks.
     pub warnings: Vec<String>,
+    /// A model played back from a recording instead of computed (see [`replay`]).
+    pub replay: Option<replay::Replay>,
 }
 
 /// A description of a run's ground motion for people: name, source, peak, sampling.
@@ -294,6 +298,7 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
         motion_info,
         exact,
         warnings: setup.warnings,
+        replay: None,
     })
 }
 
@@ -335,6 +340,11 @@ impl PreparedRun {
     /// The models are independent, so each runs on its own thread; the first model's
     /// error in scene order is returned.
     pub fn advance_to(&mut self, t: f64, samples: &mut [Samples]) -> Result<()> {
+        if self.replay.is_some() {
+            return Err(crate::Error::Scene(
+                "a run that plays a model back advances by frames only".into(),
+            ));
+        }
         self.on_each_model(samples, |dda, ex, s, motion| {
             dda.run_until(t, |d, _| ex.sample(d, Some(motion), s))
         })?;
@@ -363,6 +373,21 @@ impl PreparedRun {
             }
             Ok((frames, copy_s))
         })?;
+        let per_model: Vec<_> = per_model
+            .into_iter()
+            .zip(samples.iter_mut())
+            .map(|(computed, s)| match (computed, self.replay.as_mut()) {
+                (Some(computed), _) => Ok(computed),
+                (None, Some(replay)) => {
+                    let frames = times.iter().map(|&t| {
+                        let frame = replay.next(t, s)?;
+                        Ok((frame.time, frame))
+                    });
+                    Ok((frames.collect::<Result<Vec<_>>>()?, 0.0))
+                }
+                (None, None) => Ok((Vec::new(), 0.0)),
+            })
+            .collect::<Result<_>>()?;
         let copy_s: f64 = per_model.iter().map(|(_, s)| s).sum();
         let mut columns: Vec<_> = per_model
             .into_iter()
@@ -384,32 +409,40 @@ impl PreparedRun {
         })
     }
 
-    /// Runs `work` on every model, each on its own scoped thread (the first on this one),
-    /// and returns the results in scene order, or the first model's error in that order.
+    /// Runs `work` on every model but the one played back, each on its own scoped thread
+    /// (the first on this one), and returns the results in scene order (None for the one
+    /// played back), or the first model's error in that order.
     fn on_each_model<R: Send>(
         &mut self,
         samples: &mut [Samples],
         work: impl Fn(&mut Dda, &mut Extractor, &mut Samples, &GroundMotion) -> Result<R> + Sync,
-    ) -> Result<Vec<R>> {
+    ) -> Result<Vec<Option<R>>> {
         let motion = &self.motion;
         let work = &work;
-        let mut pairs = self.models.iter_mut().zip(samples.iter_mut());
-        let Some(((dda, ex), s)) = pairs.next() else {
+        let played = self.replay.as_ref().map(|r| r.model);
+        let mut pairs = self
+            .models
+            .iter_mut()
+            .zip(samples.iter_mut())
+            .enumerate()
+            .map(|(m, pair)| (Some(m) != played).then_some(pair));
+        let Some(first) = pairs.next() else {
             return Ok(Vec::new());
         };
         std::thread::scope(|scope| {
             let others: Vec<_> = pairs
-                .map(|((dda, ex), s)| scope.spawn(move || work(dda, ex, s, motion)))
+                .map(|pair| {
+                    pair.map(|((dda, ex), s)| scope.spawn(move || work(dda, ex, s, motion)))
+                })
                 .collect();
-            let mut results = vec![work(dda, ex, s, motion)];
+            let mut results = vec![first.map(|((dda, ex), s)| work(dda, ex, s, motion))];
             for handle in others {
-                results.push(
-                    handle
-                        .join()
-                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-                );
+                results.push(handle.map(|h| {
+                    h.join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                }));
             }
-            results.into_iter().collect()
+            results.into_iter().map(Option::transpose).collect()
         })
     }
 
@@ -457,6 +490,7 @@ pub fn run_to_messages(config: &SimConfig, until: f64) -> Result<Vec<SimMessage>
     messages.push(SimMessage::Finished {
         generation: 1,
         wall_time_s: start.elapsed().as_secs_f64(),
+        fixed_base_replayed: false,
     });
     Ok(messages)
 }
@@ -550,6 +584,9 @@ pub enum SimMessage {
         generation: u64,
         /// Wall-clock time of the run, s.
         wall_time_s: f64,
+        /// The fixed-base model was played back from the last run rather than computed
+        /// (only the sliding joint's friction changed; see [`replay`]).
+        fixed_base_replayed: bool,
     },
     /// The run could not start or stopped with an error.
     Failed {
@@ -642,6 +679,7 @@ impl Outbox {
 fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
     let mut generation = 0u64;
     let mut pending: Option<SimConfig> = None;
+    let mut kept = KeptFixedBase::default();
     loop {
         let config = match pending.take() {
             Some(c) => c,
@@ -651,11 +689,38 @@ fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
             },
         };
         generation += 1;
-        match run_one(generation, &config, &commands, &out) {
+        match run_one(generation, &config, &commands, &out, &mut kept) {
             RunEnd::Finished | RunEnd::Failed => {}
             RunEnd::Replaced(next) => pending = Some(*next),
             RunEnd::Quit => return,
         }
+    }
+}
+
+/// The fixed-base model of the last finished run, by what it depends on (see [`replay`]).
+#[derive(Default)]
+struct KeptFixedBase {
+    kept: Option<(SimConfig, Arc<replay::Recording>)>,
+}
+
+impl KeptFixedBase {
+    /// Sets `run` to play its fixed base back when the kept one is of the same key;
+    /// otherwise returns a recording to fill as it is computed (None: no fixed base).
+    fn apply(&self, config: &SimConfig, run: &mut PreparedRun) -> Option<replay::Recording> {
+        let key = replay::fixed_base_key(config)?;
+        let model = run.models.len().checked_sub(1)?;
+        match &self.kept {
+            Some((kept_key, recording)) if *kept_key == key => {
+                run.replay = Some(replay::Replay::new(Arc::clone(recording), model));
+                None
+            }
+            _ => Some(replay::Recording::default()),
+        }
+    }
+
+    /// Keeps the fixed base of a finished run of `config`.
+    fn keep(&mut self, config: &SimConfig, recording: replay::Recording) {
+        self.kept = replay::fixed_base_key(config).map(|key| (key, Arc::new(recording)));
     }
 }
 
@@ -671,6 +736,7 @@ fn run_one(
     config: &SimConfig,
     commands: &Receiver<SimCommand>,
     out: &Outbox,
+    kept: &mut KeptFixedBase,
 ) -> RunEnd {
     let start = Instant::now();
     let mut run = match prepare(config) {
@@ -683,6 +749,9 @@ fn run_one(
             return RunEnd::Failed;
         }
     };
+    let mut recording = kept.apply(config, &mut run);
+    let fixed_base = run.models.len().saturating_sub(1);
+    let replayed = run.replay.is_some();
     let mut samples = run.initial_samples();
     let _ = out.send(run.started_message(generation, config));
     let mut batch = Vec::new();
@@ -701,6 +770,9 @@ fn run_one(
         let t_chunk = Instant::now();
         match run.advance_frames(&times, &mut samples) {
             Ok(advanced) => {
+                if let Some(r) = recording.as_mut() {
+                    r.add_frames(&advanced.frames, fixed_base);
+                }
                 batch.extend(advanced.frames);
                 copy_total += advanced.copy_s_per_frame;
                 copies += 1;
@@ -721,7 +793,10 @@ fn run_one(
             let speed = target / start.elapsed().as_secs_f64().max(1e-9);
             let extract_us = 1e6 * copy_total / copies.max(1) as f64;
             let frames = std::mem::take(&mut batch);
-            let fresh = samples.iter_mut().map(std::mem::take).collect();
+            let fresh: Vec<Samples> = samples.iter_mut().map(std::mem::take).collect();
+            if let (Some(r), Some(rows)) = (recording.as_mut(), fresh.get(fixed_base)) {
+                r.add_samples(rows);
+            }
             if out
                 .send(SimMessage::Frames {
                     generation,
@@ -737,9 +812,13 @@ fn run_one(
             last_send = Instant::now();
         }
         if done {
+            if let Some(r) = recording.take() {
+                kept.keep(config, r);
+            }
             let _ = out.send(SimMessage::Finished {
                 generation,
                 wall_time_s: start.elapsed().as_secs_f64(),
+                fixed_base_replayed: replayed,
             });
             return RunEnd::Finished;
         }
@@ -876,5 +955,105 @@ mod tests {
             }
             other => panic!("expected a failure, got {other:?}"),
         }
+    }
+
+    /// Everything a finished run posted: its frames, each model's samples (the first row
+    /// included) and whether the fixed base was played back.
+    fn posted(handle: &SimHandle, config: &SimConfig) -> (Vec<FrameSet>, Vec<Samples>, bool) {
+        assert!(handle.send(SimCommand::Run(Box::new(config.clone()))));
+        let (mut frames, mut samples) = (Vec::new(), Vec::new());
+        loop {
+            match handle
+                .messages
+                .recv_timeout(Duration::from_secs(120))
+                .unwrap()
+            {
+                SimMessage::Started { .. } => {}
+                SimMessage::Frames {
+                    frames: f,
+                    samples: mut s,
+                    ..
+                } => {
+                    frames.extend(f);
+                    samples.resize_with(s.len(), Samples::default);
+                    for (all, new) in samples.iter_mut().zip(&mut s) {
+                        all.append(new);
+                    }
+                }
+                SimMessage::Finished {
+                    fixed_base_replayed,
+                    ..
+                } => return (frames, samples, fixed_base_replayed),
+                SimMessage::Failed { message, .. } => panic!("{message}"),
+            }
+        }
+    }
+
+    /// The fixed base of a run computed on its own (not through the thread).
+    fn computed_fixed_base(config: &SimConfig) -> (Vec<ModelFrame>, Samples) {
+        let messages = run_to_messages(config, f64::INFINITY).unwrap();
+        let Some(SimMessage::Frames {
+            frames, samples, ..
+        }) = messages.into_iter().nth(1)
+        else {
+            panic!("no frames");
+        };
+        let fixed = frames
+            .into_iter()
+            .map(|f| f.models.last().unwrap().clone())
+            .collect();
+        (fixed, samples.last().unwrap().clone())
+    }
+
+    /// When only the sliding joint's friction changes (a friction slider dragged), the
+    /// fixed base is played back from the last run, and what the UI gets is what
+    /// computing it again gives, to the bit: every frame and the samples of every step.
+    /// Another change (the record's scale) computes it again.
+    #[test]
+    fn the_fixed_base_is_played_back_when_only_the_friction_changes() {
+        let handle = SimHandle::spawn();
+        let first = SimConfig {
+            duration: Some(0.6),
+            frame_dt: 0.05,
+            ..SimConfig::default()
+        };
+        let (_, _, replayed) = posted(&handle, &first);
+        assert!(!replayed, "nothing to play back yet");
+        let other_friction = SimConfig {
+            friction: Some(0.05),
+            ..first.clone()
+        };
+        let other_law = SimConfig {
+            friction_law: Some(crate::model::friction::Friction::StaticKinetic {
+                stick: 0.15,
+                slide: 0.1,
+            }),
+            ..first.clone()
+        };
+        for config in [&other_friction, &other_law] {
+            let (frames, samples, replayed) = posted(&handle, config);
+            assert!(replayed, "{config:?}");
+            let (fixed_frames, fixed_samples) = computed_fixed_base(config);
+            let played: Vec<ModelFrame> = frames
+                .iter()
+                .map(|f| f.models.last().unwrap().clone())
+                .collect();
+            assert_eq!(played.len(), 12);
+            assert!(played == fixed_frames, "frames differ: {config:?}");
+            assert!(*samples.last().unwrap() == fixed_samples, "samples differ");
+            // The sliding model is this friction's, not the first run's.
+            let sliding = &frames.last().unwrap().models[0];
+            let computed = run_to_messages(config, f64::INFINITY).unwrap();
+            let Some(SimMessage::Frames { frames: own, .. }) = computed.into_iter().nth(1) else {
+                panic!("no frames");
+            };
+            assert!(*sliding == own.last().unwrap().models[0]);
+        }
+        let scaled = SimConfig {
+            pga_g: Some(0.3),
+            ..other_friction
+        };
+        let (_, _, replayed) = posted(&handle, &scaled);
+        assert!(!replayed, "a new scale computes the fixed base again");
     }
 }

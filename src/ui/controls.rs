@@ -574,10 +574,10 @@ impl AppState {
         ui.label(format!(
             "simulation: {:.1}× real time{}",
             self.timeline.sim_speed,
-            if self.timeline.finished {
-                " (done)"
-            } else {
-                ""
+            match (self.timeline.finished, self.timeline.fixed_base_replayed) {
+                (true, true) => " (done; the fixed base kept from the last run)",
+                (true, false) => " (done)",
+                (false, _) => "",
             }
         ));
         ui.label(format!(

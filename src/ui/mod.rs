@@ -302,6 +302,9 @@ pub struct Timeline {
     pub sim_speed: f64,
     /// The run reached its end.
     pub finished: bool,
+    /// The fixed-base model was played back from the last run (only the friction
+    /// changed), not computed again.
+    pub fixed_base_replayed: bool,
     /// The configuration of this run.
     pub config: Option<SimConfig>,
 }
@@ -553,6 +556,7 @@ impl AppState {
                     motion: *motion,
                     sim_speed: 0.0,
                     finished: false,
+                    fixed_base_replayed: false,
                     config: Some(*config),
                 };
                 self.play_time = match self.resume_at {
@@ -581,8 +585,13 @@ impl AppState {
                     self.resume_at = None;
                 }
             }
-            SimMessage::Finished { generation, .. } if generation == self.timeline.generation => {
+            SimMessage::Finished {
+                generation,
+                fixed_base_replayed,
+                ..
+            } if generation == self.timeline.generation => {
                 self.timeline.finished = true;
+                self.timeline.fixed_base_replayed = fixed_base_replayed;
                 self.resume_at = None;
             }
             SimMessage::Failed { message, .. } => {
