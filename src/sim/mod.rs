@@ -770,8 +770,10 @@ fn run_one(
         let t_chunk = Instant::now();
         match run.advance_frames(&times, &mut samples) {
             Ok(advanced) => {
-                if let Some(r) = recording.as_mut() {
-                    r.add_frames(&advanced.frames, fixed_base);
+                if let Some(r) = recording.as_mut()
+                    && !r.add_frames(&advanced.frames, fixed_base)
+                {
+                    recording = None;
                 }
                 batch.extend(advanced.frames);
                 copy_total += advanced.copy_s_per_frame;

@@ -22,18 +22,37 @@ pub fn fixed_base_key(config: &SimConfig) -> Option<SimConfig> {
     })
 }
 
+/// The most a recording holds, in parts of frames (blocks, contacts, bolts and
+/// connections, each ~50–150 bytes): ~50 MB. The default scene's fixed base over El
+/// Centro is ~2e5; a large wall's would be tens of millions, a copy of what the window
+/// already holds, and is not kept.
+const MAX_RECORDED_PARTS: usize = 500_000;
+
 /// A model's frames and full-rate samples over a whole run.
 #[derive(Debug, Clone, Default)]
 pub struct Recording {
     frames: Vec<ModelFrame>,
     samples: Samples,
+    /// Parts of the frames so far (see [`MAX_RECORDED_PARTS`]).
+    parts: usize,
 }
 
 impl Recording {
-    /// Adds model `model`'s frame of each frame set.
-    pub fn add_frames(&mut self, frames: &[FrameSet], model: usize) {
-        self.frames
-            .extend(frames.iter().filter_map(|f| f.models.get(model).cloned()));
+    /// Adds model `model`'s frame of each frame set; false (and the recording emptied)
+    /// once it would hold more than [`MAX_RECORDED_PARTS`].
+    pub fn add_frames(&mut self, frames: &[FrameSet], model: usize) -> bool {
+        for frame in frames.iter().filter_map(|f| f.models.get(model)) {
+            self.parts += frame.blocks.len()
+                + frame.contacts.len()
+                + frame.bolts.len()
+                + frame.connections.len();
+            if self.parts > MAX_RECORDED_PARTS {
+                *self = Self::default();
+                return false;
+            }
+            self.frames.push(frame.clone());
+        }
+        true
     }
 
     /// Adds rows of the model's samples.
@@ -89,5 +108,34 @@ impl Replay {
         samples.push_rows(recorded, self.next_row..end);
         self.next_row = end;
         Ok(frame.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A recording grows frame by frame up to its bound, then gives up and lets go of
+    /// what it held (a large wall's fixed base is not kept).
+    #[test]
+    fn a_recording_stops_at_its_bound() {
+        let config = SimConfig {
+            scene: "wall:10".into(),
+            ..SimConfig::default()
+        };
+        let frames = [super::super::prepare(&config).unwrap().frame_set()];
+        let parts = {
+            let f = &frames[0].models[0];
+            f.blocks.len() + f.contacts.len() + f.bolts.len() + f.connections.len()
+        };
+        assert!(parts > 100, "{parts}");
+        let mut recording = Recording::default();
+        let fitting = MAX_RECORDED_PARTS / parts;
+        for _ in 0..fitting {
+            assert!(recording.add_frames(&frames, 0));
+        }
+        assert_eq!(recording.frames.len(), fitting);
+        assert!(!recording.add_frames(&frames, 0));
+        assert!(recording.frames.is_empty() && recording.parts == 0);
     }
 }
