@@ -86,7 +86,7 @@ fn synthetic(generation: u64, duration: f64, upto: f64) -> Vec<SimMessage> {
         msgs.push(SimMessage::Finished {
             generation,
             wall_time_s: 0.1,
-            fixed_base_replayed: false,
+            replayed_models: 0,
         });
     }
     msgs

@@ -126,8 +126,11 @@ pub struct PreparedRun {
     /// What the user should know about the run (e.g. a time step that barely resolves the
     /// excitation), from the shared set-up's checks.
     pub warnings: Vec<String>,
-    /// A model played back from a recording instead of computed (see [`replay`]).
-    pub replay: Option<replay::Replay>,
+    /// Which model each is (what it depends on besides the run's shared settings).
+    pub roles: Vec<replay::ModelRole>,
+    /// Per model, the recording it is played back from instead of computed (see
+    /// [`replay`]; empty: all computed).
+    pub replays: Vec<Option<replay::Replay>>,
 }
 
 /// A description of a run's ground motion for people: name, source, peak, sampling.
@@ -262,7 +265,12 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
         ),
         None => sliding_label(setup.friction),
     };
-    let mut scenes = vec![(setup.scene.clone(), main_label)];
+    let (friction, law) = (config.friction, config.friction_law);
+    let mut scenes = vec![(
+        setup.scene.clone(),
+        main_label,
+        replay::ModelRole::Main(friction, law),
+    )];
     if config.compare_flat && radius.is_some() {
         let flat = RunSpec {
             bearing: None,
@@ -273,20 +281,32 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
             "flat joint, ρ = {}",
             crate::post::format_number(setup.friction)
         );
-        scenes.push((flat.scene, label));
+        scenes.push((flat.scene, label, replay::ModelRole::Flat(friction, law)));
     }
     for &f in &config.compare_friction {
-        scenes.push((setup.friction_variant_scene(f)?, sliding_label(f)));
+        let scene = setup.friction_variant_scene(f)?;
+        scenes.push((
+            scene,
+            sliding_label(f),
+            replay::ModelRole::ComparedFriction(f),
+        ));
     }
     if config.compare_fixed {
-        scenes.push((setup.fixed_base_scene(), "fixed base".to_string()));
+        let scene = setup.fixed_base_scene();
+        scenes.push((
+            scene,
+            "fixed base".to_string(),
+            replay::ModelRole::FixedBase,
+        ));
     }
     let mut models = Vec::new();
     let mut labels = Vec::new();
-    for (scene, label) in &scenes {
-        let (dda, probe) = setup.build_dda(scene, setup.solver_params())?;
+    let mut roles = Vec::new();
+    for (scene, label, role) in scenes {
+        roles.push(role);
+        let (dda, probe) = setup.build_dda(&scene, setup.solver_params())?;
         let ex = Extractor::new(&dda, probe.base, probe.roof);
-        labels.push(label.clone());
+        labels.push(label);
         models.push((dda, ex));
     }
     Ok(PreparedRun {
@@ -298,7 +318,8 @@ pub fn prepare(config: &SimConfig) -> Result<PreparedRun> {
         motion_info,
         exact,
         warnings: setup.warnings,
-        replay: None,
+        roles,
+        replays: Vec::new(),
     })
 }
 
@@ -340,7 +361,7 @@ impl PreparedRun {
     /// The models are independent, so each runs on its own thread; the first model's
     /// error in scene order is returned.
     pub fn advance_to(&mut self, t: f64, samples: &mut [Samples]) -> Result<()> {
-        if self.replay.is_some() {
+        if self.replays.iter().any(Option::is_some) {
             return Err(crate::Error::Scene(
                 "a run that plays a model back advances by frames only".into(),
             ));
@@ -376,17 +397,20 @@ impl PreparedRun {
         let per_model: Vec<_> = per_model
             .into_iter()
             .zip(samples.iter_mut())
-            .map(|(computed, s)| match (computed, self.replay.as_mut()) {
-                (Some(computed), _) => Ok(computed),
-                (None, Some(replay)) => {
-                    let frames = times.iter().map(|&t| {
-                        let frame = replay.next(t, s)?;
-                        Ok((frame.time, frame))
-                    });
-                    Ok((frames.collect::<Result<Vec<_>>>()?, 0.0))
-                }
-                (None, None) => Ok((Vec::new(), 0.0)),
-            })
+            .enumerate()
+            .map(
+                |(m, (computed, s))| match (computed, self.replays.get_mut(m)) {
+                    (Some(computed), _) => Ok(computed),
+                    (None, Some(Some(replay))) => {
+                        let frames = times.iter().map(|&t| {
+                            let frame = replay.next(t, s)?;
+                            Ok((frame.time, frame))
+                        });
+                        Ok((frames.collect::<Result<Vec<_>>>()?, 0.0))
+                    }
+                    (None, _) => Ok((Vec::new(), 0.0)),
+                },
+            )
             .collect::<Result<_>>()?;
         let copy_s: f64 = per_model.iter().map(|(_, s)| s).sum();
         let mut columns: Vec<_> = per_model
@@ -409,8 +433,8 @@ impl PreparedRun {
         })
     }
 
-    /// Runs `work` on every model but the one played back, each on its own scoped thread
-    /// (the first on this one), and returns the results in scene order (None for the one
+    /// Runs `work` on every model but those played back, each on its own scoped thread
+    /// (the first on this one), and returns the results in scene order (None for those
     /// played back), or the first model's error in that order.
     fn on_each_model<R: Send>(
         &mut self,
@@ -419,13 +443,14 @@ impl PreparedRun {
     ) -> Result<Vec<Option<R>>> {
         let motion = &self.motion;
         let work = &work;
-        let played = self.replay.as_ref().map(|r| r.model);
+        let replays = &self.replays;
+        let played = |m: usize| replays.get(m).is_some_and(Option::is_some);
         let mut pairs = self
             .models
             .iter_mut()
             .zip(samples.iter_mut())
             .enumerate()
-            .map(|(m, pair)| (Some(m) != played).then_some(pair));
+            .map(|(m, pair)| (!played(m)).then_some(pair));
         let Some(first) = pairs.next() else {
             return Ok(Vec::new());
         };
@@ -490,7 +515,7 @@ pub fn run_to_messages(config: &SimConfig, until: f64) -> Result<Vec<SimMessage>
     messages.push(SimMessage::Finished {
         generation: 1,
         wall_time_s: start.elapsed().as_secs_f64(),
-        fixed_base_replayed: false,
+        replayed_models: 0,
     });
     Ok(messages)
 }
@@ -584,9 +609,9 @@ pub enum SimMessage {
         generation: u64,
         /// Wall-clock time of the run, s.
         wall_time_s: f64,
-        /// The fixed-base model was played back from the last run rather than computed
-        /// (only the sliding joint's friction changed; see [`replay`]).
-        fixed_base_replayed: bool,
+        /// How many of the models were played back from the last run rather than
+        /// computed (nothing they depend on changed; see [`replay`]).
+        replayed_models: usize,
     },
     /// The run could not start or stopped with an error.
     Failed {
@@ -679,7 +704,7 @@ impl Outbox {
 fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
     let mut generation = 0u64;
     let mut pending: Option<SimConfig> = None;
-    let mut kept = KeptFixedBase::default();
+    let mut kept = KeptModels::default();
     loop {
         let config = match pending.take() {
             Some(c) => c,
@@ -697,30 +722,51 @@ fn sim_thread(commands: Receiver<SimCommand>, out: Outbox) {
     }
 }
 
-/// The fixed-base model of the last finished run, by what it depends on (see [`replay`]).
+/// The models of the last finished run, by what each depends on (see [`replay`]).
 #[derive(Default)]
-struct KeptFixedBase {
-    kept: Option<(SimConfig, Arc<replay::Recording>)>,
+struct KeptModels {
+    kept: Vec<(replay::ModelKey, Arc<replay::Recording>)>,
 }
 
-impl KeptFixedBase {
-    /// Sets `run` to play its fixed base back when the kept one is of the same key;
-    /// otherwise returns a recording to fill as it is computed (None: no fixed base).
-    fn apply(&self, config: &SimConfig, run: &mut PreparedRun) -> Option<replay::Recording> {
-        let key = replay::fixed_base_key(config)?;
-        let model = run.models.len().checked_sub(1)?;
-        match &self.kept {
-            Some((kept_key, recording)) if *kept_key == key => {
-                run.replay = Some(replay::Replay::new(Arc::clone(recording), model));
-                None
-            }
-            _ => Some(replay::Recording::default()),
-        }
+impl KeptModels {
+    /// Sets `run` to play back each model kept under its key, and returns, per model, a
+    /// recording to fill as it is computed (None for those played back).
+    fn apply(&self, config: &SimConfig, run: &mut PreparedRun) -> Vec<Option<replay::Recording>> {
+        let keys = run
+            .roles
+            .iter()
+            .map(|r| replay::ModelKey::new(config, r.clone()));
+        run.replays = keys
+            .map(|key| {
+                let kept = self.kept.iter().find(|(k, _)| *k == key);
+                kept.map(|(_, recording)| replay::Replay::new(Arc::clone(recording)))
+            })
+            .collect();
+        run.replays
+            .iter()
+            .map(|r| r.is_none().then(replay::Recording::default))
+            .collect()
     }
 
-    /// Keeps the fixed base of a finished run of `config`.
-    fn keep(&mut self, config: &SimConfig, recording: replay::Recording) {
-        self.kept = replay::fixed_base_key(config).map(|key| (key, Arc::new(recording)));
+    /// Keeps the models of a finished run of `config`: those played back and those
+    /// recorded in full.
+    fn keep(
+        &mut self,
+        config: &SimConfig,
+        run: &PreparedRun,
+        recordings: Vec<Option<replay::Recording>>,
+    ) {
+        let models = run.roles.iter().zip(&run.replays).zip(recordings);
+        self.kept = models
+            .filter_map(|((role, played), recorded)| {
+                let recording = match (played, recorded) {
+                    (Some(replay), _) => Arc::clone(replay.recording()),
+                    (None, Some(recorded)) => Arc::new(recorded),
+                    (None, None) => return None,
+                };
+                Some((replay::ModelKey::new(config, role.clone()), recording))
+            })
+            .collect();
     }
 }
 
@@ -736,7 +782,7 @@ fn run_one(
     config: &SimConfig,
     commands: &Receiver<SimCommand>,
     out: &Outbox,
-    kept: &mut KeptFixedBase,
+    kept: &mut KeptModels,
 ) -> RunEnd {
     let start = Instant::now();
     let mut run = match prepare(config) {
@@ -749,9 +795,8 @@ fn run_one(
             return RunEnd::Failed;
         }
     };
-    let mut recording = kept.apply(config, &mut run);
-    let fixed_base = run.models.len().saturating_sub(1);
-    let replayed = run.replay.is_some();
+    let mut recordings = kept.apply(config, &mut run);
+    let replayed = run.replays.iter().filter(|r| r.is_some()).count();
     let mut samples = run.initial_samples();
     let _ = out.send(run.started_message(generation, config));
     let mut batch = Vec::new();
@@ -770,10 +815,13 @@ fn run_one(
         let t_chunk = Instant::now();
         match run.advance_frames(&times, &mut samples) {
             Ok(advanced) => {
-                if let Some(r) = recording.as_mut()
-                    && !r.add_frames(&advanced.frames, fixed_base)
-                {
-                    recording = None;
+                for (m, recording) in recordings.iter_mut().enumerate() {
+                    if recording
+                        .as_mut()
+                        .is_some_and(|r| !r.add_frames(&advanced.frames, m))
+                    {
+                        *recording = None;
+                    }
                 }
                 batch.extend(advanced.frames);
                 copy_total += advanced.copy_s_per_frame;
@@ -796,8 +844,10 @@ fn run_one(
             let extract_us = 1e6 * copy_total / copies.max(1) as f64;
             let frames = std::mem::take(&mut batch);
             let fresh: Vec<Samples> = samples.iter_mut().map(std::mem::take).collect();
-            if let (Some(r), Some(rows)) = (recording.as_mut(), fresh.get(fixed_base)) {
-                r.add_samples(rows);
+            for (recording, rows) in recordings.iter_mut().zip(&fresh) {
+                if let Some(r) = recording {
+                    r.add_samples(rows);
+                }
             }
             if out
                 .send(SimMessage::Frames {
@@ -814,13 +864,11 @@ fn run_one(
             last_send = Instant::now();
         }
         if done {
-            if let Some(r) = recording.take() {
-                kept.keep(config, r);
-            }
+            kept.keep(config, &run, recordings);
             let _ = out.send(SimMessage::Finished {
                 generation,
                 wall_time_s: start.elapsed().as_secs_f64(),
-                fixed_base_replayed: replayed,
+                replayed_models: replayed,
             });
             return RunEnd::Finished;
         }
@@ -960,8 +1008,8 @@ mod tests {
     }
 
     /// Everything a finished run posted: its frames, each model's samples (the first row
-    /// included) and whether the fixed base was played back.
-    fn posted(handle: &SimHandle, config: &SimConfig) -> (Vec<FrameSet>, Vec<Samples>, bool) {
+    /// included) and how many models were played back.
+    fn posted(handle: &SimHandle, config: &SimConfig) -> (Vec<FrameSet>, Vec<Samples>, usize) {
         assert!(handle.send(SimCommand::Run(Box::new(config.clone()))));
         let (mut frames, mut samples) = (Vec::new(), Vec::new());
         loop {
@@ -983,48 +1031,58 @@ mod tests {
                     }
                 }
                 SimMessage::Finished {
-                    fixed_base_replayed,
-                    ..
-                } => return (frames, samples, fixed_base_replayed),
+                    replayed_models, ..
+                } => return (frames, samples, replayed_models),
                 SimMessage::Failed { message, .. } => panic!("{message}"),
             }
         }
     }
 
-    /// The fixed base of a run computed on its own (not through the thread).
-    fn computed_fixed_base(config: &SimConfig) -> (Vec<ModelFrame>, Samples) {
-        let messages = run_to_messages(config, f64::INFINITY).unwrap();
+    /// Runs `config` on the thread and checks that every model's frames and samples are
+    /// what computing the run on its own gives, to the bit; returns how many models the
+    /// thread played back.
+    fn played_back(handle: &SimHandle, config: &SimConfig) -> usize {
+        let (frames, samples, replayed) = posted(handle, config);
+        let computed = run_to_messages(config, f64::INFINITY).unwrap();
         let Some(SimMessage::Frames {
-            frames, samples, ..
-        }) = messages.into_iter().nth(1)
+            frames: own_frames,
+            samples: own_samples,
+            ..
+        }) = computed.into_iter().nth(1)
         else {
             panic!("no frames");
         };
-        let fixed = frames
-            .into_iter()
-            .map(|f| f.models.last().unwrap().clone())
-            .collect();
-        (fixed, samples.last().unwrap().clone())
+        assert_eq!(frames.len(), 12, "{config:?}");
+        for (posted, own) in frames.iter().zip(&own_frames) {
+            assert!(
+                posted.models == own.models,
+                "frames differ at {}: {config:?}",
+                own.time
+            );
+        }
+        assert!(samples == own_samples, "samples differ: {config:?}");
+        replayed
     }
 
-    /// When only the sliding joint's friction changes (a friction slider dragged), the
-    /// fixed base is played back from the last run, and what the UI gets is what
-    /// computing it again gives, to the bit: every frame and the samples of every step.
-    /// Another change (the record's scale) computes it again.
+    /// A model is played back from the last run when nothing it depends on changed —
+    /// the fixed base when a friction changes, a compared friction's model when the main
+    /// friction changes — and what the UI gets is what computing the run gives, to the
+    /// bit: every frame of every model and the samples of every step. A change of the
+    /// shared settings (the record's scale) computes every model again.
     #[test]
-    fn the_fixed_base_is_played_back_when_only_the_friction_changes() {
+    fn models_are_played_back_when_nothing_they_depend_on_changed() {
         let handle = SimHandle::spawn();
         let first = SimConfig {
             duration: Some(0.6),
             frame_dt: 0.05,
             ..SimConfig::default()
         };
-        let (_, _, replayed) = posted(&handle, &first);
-        assert!(!replayed, "nothing to play back yet");
+        assert_eq!(played_back(&handle, &first), 0, "nothing to play back yet");
         let other_friction = SimConfig {
             friction: Some(0.05),
             ..first.clone()
         };
+        assert_eq!(played_back(&handle, &other_friction), 1, "the fixed base");
         let other_law = SimConfig {
             friction_law: Some(crate::model::friction::Friction::StaticKinetic {
                 stick: 0.15,
@@ -1032,30 +1090,34 @@ mod tests {
             }),
             ..first.clone()
         };
-        for config in [&other_friction, &other_law] {
-            let (frames, samples, replayed) = posted(&handle, config);
-            assert!(replayed, "{config:?}");
-            let (fixed_frames, fixed_samples) = computed_fixed_base(config);
-            let played: Vec<ModelFrame> = frames
-                .iter()
-                .map(|f| f.models.last().unwrap().clone())
-                .collect();
-            assert_eq!(played.len(), 12);
-            assert!(played == fixed_frames, "frames differ: {config:?}");
-            assert!(*samples.last().unwrap() == fixed_samples, "samples differ");
-            // The sliding model is this friction's, not the first run's.
-            let sliding = &frames.last().unwrap().models[0];
-            let computed = run_to_messages(config, f64::INFINITY).unwrap();
-            let Some(SimMessage::Frames { frames: own, .. }) = computed.into_iter().nth(1) else {
-                panic!("no frames");
-            };
-            assert!(*sliding == own.last().unwrap().models[0]);
-        }
+        assert_eq!(played_back(&handle, &other_law), 1, "the fixed base");
         let scaled = SimConfig {
             pga_g: Some(0.3),
             ..other_friction
         };
-        let (_, _, replayed) = posted(&handle, &scaled);
-        assert!(!replayed, "a new scale computes the fixed base again");
+        assert_eq!(played_back(&handle, &scaled), 0, "a new scale");
+        let compared = SimConfig {
+            compare_friction: vec![0.05, 0.2],
+            ..first.clone()
+        };
+        assert_eq!(played_back(&handle, &compared), 0, "new shared settings");
+        let main_dragged = SimConfig {
+            friction: Some(0.02),
+            ..compared.clone()
+        };
+        assert_eq!(
+            played_back(&handle, &main_dragged),
+            3,
+            "all but the main model"
+        );
+        let compared_dragged = SimConfig {
+            compare_friction: vec![0.05, 0.3],
+            ..main_dragged
+        };
+        assert_eq!(
+            played_back(&handle, &compared_dragged),
+            3,
+            "all but ρ = 0.3's"
+        );
     }
 }

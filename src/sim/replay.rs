@@ -1,32 +1,58 @@
-//! The fixed-base model of the last finished run, kept for the next one: the fixed base
-//! does not depend on the sliding joint's friction (its joint is bonded: locked at every
-//! step, its friction never consulted), so when only the friction changes — a friction
-//! slider dragged — its frames and samples are played back instead of computed again,
-//! and the sliding model has the second core to itself. Everything else that defines the
-//! run (scene, record, scale, time step, integrator, damping, bearing, duration, frame
-//! interval) is part of the key: any change to it computes the fixed base again.
+//! The models of the last finished run, kept for the next one: a model is played back
+//! frame by frame instead of computed again when nothing it depends on changed. The
+//! models of a run share its settings (scene, record, scale, time step, integrator,
+//! damping, bearing, duration, frame interval) and differ in the sliding joint's
+//! friction: the main model has the run's, each compared model its own, and the fixed
+//! base none (its joint is bonded: locked at every step, its friction never consulted).
+//! So when a friction slider is dragged only the model with that friction is computed
+//! again, and the others leave it the cores.
 
 use std::sync::Arc;
 
 use super::{FrameSet, ModelFrame, Samples, SimConfig};
+use crate::model::friction::Friction;
 use crate::{Error, Result};
 
-/// What the fixed-base model of `config` depends on: the configuration without the
-/// sliding joint's friction (None: the run has no fixed-base model).
-pub fn fixed_base_key(config: &SimConfig) -> Option<SimConfig> {
-    config.compare_fixed.then(|| SimConfig {
-        friction: None,
-        friction_law: None,
-        compare_friction: Vec::new(),
-        ..config.clone()
-    })
+/// Which model of a run it is, with the friction it has of its own.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ModelRole {
+    /// The main model: the run's friction coefficient and law.
+    Main(Option<f64>, Option<Friction>),
+    /// The same frame on the flat joint (next to pendulum bearings): the run's friction.
+    Flat(Option<f64>, Option<Friction>),
+    /// A model compared at another friction coefficient.
+    ComparedFriction(f64),
+    /// The fixed base.
+    FixedBase,
 }
 
-/// The most a recording holds, in parts of frames (blocks, contacts, bolts and
-/// connections, each ~50–150 bytes): ~50 MB. The default scene's fixed base over El
-/// Centro is ~2e5; a large wall's would be tens of millions, a copy of what the window
-/// already holds, and is not kept.
-const MAX_RECORDED_PARTS: usize = 500_000;
+/// What a model of a run depends on: the run's shared settings and its role.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelKey {
+    shared: SimConfig,
+    role: ModelRole,
+}
+
+impl ModelKey {
+    /// The key of the model with `role` in a run of `config`.
+    pub fn new(config: &SimConfig, role: ModelRole) -> Self {
+        Self {
+            shared: SimConfig {
+                friction: None,
+                friction_law: None,
+                compare_friction: Vec::new(),
+                ..config.clone()
+            },
+            role,
+        }
+    }
+}
+
+/// The most a recording of one model holds, in parts of frames (blocks, contacts, bolts
+/// and connections, each ~50–150 bytes): ~40 MB. A three-storey frame over El Centro is
+/// ~2e5; a large wall's would be tens of millions, a copy of what the window already
+/// holds, and is not kept.
+const MAX_RECORDED_PARTS: usize = 400_000;
 
 /// A model's frames and full-rate samples over a whole run.
 #[derive(Debug, Clone, Default)]
@@ -61,26 +87,28 @@ impl Recording {
     }
 }
 
-/// A recording played back as model `model` of a run.
+/// A recording played back as a model of a run.
 #[derive(Debug, Clone)]
 pub struct Replay {
     recording: Arc<Recording>,
-    /// The model it stands for.
-    pub model: usize,
     next_frame: usize,
     next_row: usize,
 }
 
 impl Replay {
-    /// Plays `recording` back from its start as model `model`.
-    pub fn new(recording: Arc<Recording>, model: usize) -> Self {
+    /// Plays `recording` back from its start.
+    pub fn new(recording: Arc<Recording>) -> Self {
         Self {
             recording,
-            model,
             next_frame: 0,
             // The first row (t = 0) is the run's own: read off its model as built.
             next_row: 1,
         }
+    }
+
+    /// The recording it plays.
+    pub fn recording(&self) -> &Arc<Recording> {
+        &self.recording
     }
 
     /// The next recorded frame, for frame time `t`, and the samples of the steps up to it
@@ -93,7 +121,7 @@ impl Replay {
             .filter(|f| (f.time - t).abs() <= 1e-9 * t.abs().max(1.0))
             .ok_or_else(|| {
                 Error::Scene(format!(
-                    "the kept fixed-base run has no frame at t = {t} s (internal error: \
+                    "the kept run of a model has no frame at t = {t} s (internal error: \
                      its key did not cover the frame times)"
                 ))
             })?;

@@ -571,13 +571,14 @@ impl AppState {
 
     fn section_diagnostics(&mut self, ui: &mut egui::Ui) {
         self.view.show_diagnostics = true;
+        let (kept, models) = (self.timeline.replayed_models, self.timeline.labels.len());
         ui.label(format!(
             "simulation: {:.1}× real time{}",
             self.timeline.sim_speed,
-            match (self.timeline.finished, self.timeline.fixed_base_replayed) {
-                (true, true) => " (done; the fixed base kept from the last run)",
-                (true, false) => " (done)",
-                (false, _) => "",
+            match (self.timeline.finished, kept) {
+                (true, 0) => " (done)".to_string(),
+                (true, k) => format!(" (done; {k} of {models} models kept from the last run)"),
+                (false, _) => String::new(),
             }
         ));
         ui.label(format!(

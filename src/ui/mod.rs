@@ -302,9 +302,9 @@ pub struct Timeline {
     pub sim_speed: f64,
     /// The run reached its end.
     pub finished: bool,
-    /// The fixed-base model was played back from the last run (only the friction
-    /// changed), not computed again.
-    pub fixed_base_replayed: bool,
+    /// How many models were played back from the last run (nothing they depend on
+    /// changed) rather than computed again.
+    pub replayed_models: usize,
     /// The configuration of this run.
     pub config: Option<SimConfig>,
 }
@@ -556,7 +556,7 @@ impl AppState {
                     motion: *motion,
                     sim_speed: 0.0,
                     finished: false,
-                    fixed_base_replayed: false,
+                    replayed_models: 0,
                     config: Some(*config),
                 };
                 self.play_time = match self.resume_at {
@@ -587,11 +587,11 @@ impl AppState {
             }
             SimMessage::Finished {
                 generation,
-                fixed_base_replayed,
+                replayed_models,
                 ..
             } if generation == self.timeline.generation => {
                 self.timeline.finished = true;
-                self.timeline.fixed_base_replayed = fixed_base_replayed;
+                self.timeline.replayed_models = replayed_models;
                 self.resume_at = None;
             }
             SimMessage::Failed { message, .. } => {
