@@ -83,7 +83,7 @@ impl Recording {
 
     /// Adds rows of the model's samples.
     pub fn add_samples(&mut self, samples: &Samples) {
-        self.samples.append(&mut samples.clone());
+        self.samples.push_rows(samples, 0..samples.len());
     }
 }
 

@@ -250,12 +250,13 @@ impl Dda {
                     sys.add_scalar_spring_rhs(&self.dofs, &still, p, -m, i, Some(j));
                 }
             }
-            self.hold_rigid_strains(&mut sys);
+            // (The matrix's rigid holds are in; the right-hand side's are zeroed.)
+            self.hold_rigid_change(sys.r.as_mut_slice());
+            let rhs = sys.r.as_slice();
             let solved = if update == 0 {
-                self.linear
-                    .solve(&sys.k, sys.r.as_slice(), key, &mut solution)
+                self.linear.solve(&sys.k, rhs, key, &mut solution)
             } else {
-                (self.linear).solve_unchanged(&sys.k, sys.r.as_slice(), key, &mut solution)
+                self.linear.solve_unchanged(&sys.k, rhs, key, &mut solution)
             };
             solved.map_err(|e| self.solve_error(e))?;
             let x = self.increments(&solution, &still);
