@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use crate::render::Renderer;
-use crate::sim::SimHandle;
+use crate::sim::{SimHandle, Wake};
 use crate::ui::{AppState, ShellRequest};
 use crate::{Error, Result};
 
@@ -26,11 +26,12 @@ const FRAME_INTERVAL: Duration = Duration::from_micros(16_667);
 const COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(100);
 
 /// The same where the frames are drawn in software (Mesa's llvmpipe, a machine without a
-/// GPU): a frame of the default layout at 1600×900 costs ~55 ms of CPU there, so at 10
-/// frames a second the drawing took half a core from the two simulations (17–18× real
-/// time under Xvfb against 22–24× at 4 frames a second; docs/performance.md). Input still
-/// repaints at once; only the computing run's own redraws are paced.
-const SOFTWARE_COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(250);
+/// GPU): there a frame of the default layout at 1600×900 costs ~80–90 ms of CPU, taken
+/// from the two simulations on the same cores. At 10 frames a second the run computed at
+/// 17–18× real time under Xvfb, at 4 a second 24–29×, at 2 a second 26–31×
+/// (docs/performance.md). Input still repaints at once, and the end of the run is shown
+/// at once (see [`Wake`]); only the computing run's own progress frames are paced.
+const SOFTWARE_COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(500);
 
 /// How often the window redraws while a run computes, for the adapter that draws it.
 fn computing_frame_interval(adapter: &wgpu::AdapterInfo) -> Duration {
@@ -93,8 +94,10 @@ pub fn run_app() -> Result<()> {
                 ));
             let computing_interval = computing_frame_interval(&render_state.adapter.get_info());
             let ctx = cc.egui_ctx.clone();
-            let sim = SimHandle::spawn_with_waker(Box::new(move || {
-                ctx.request_repaint_after(computing_interval)
+            let sim = SimHandle::spawn_with_waker(Box::new(move |wake| match wake {
+                Wake::Progress => ctx.request_repaint_after(computing_interval),
+                // A finished run is shown at once, not at the computing pace.
+                Wake::RunEnded => ctx.request_repaint(),
             }));
             let (shots_tx, shots_rx) = std::sync::mpsc::channel();
             Ok(Box::new(App {

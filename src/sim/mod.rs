@@ -631,8 +631,17 @@ pub enum SimCommand {
     Quit,
 }
 
+/// Why the simulation thread wakes a UI after posting a message.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wake {
+    /// A run started or computed more frames: worth showing at the UI's own pace.
+    Progress,
+    /// A run finished or failed: its whole replay (or its error) is worth showing at once.
+    RunEnded,
+}
+
 /// Called by the simulation thread after it posts a message (a UI wakes up to show it).
-pub type Waker = Box<dyn Fn() + Send>;
+pub type Waker = Box<dyn Fn(Wake) + Send>;
 
 /// The UI's end of the simulation thread.
 pub struct SimHandle {
@@ -645,7 +654,7 @@ pub struct SimHandle {
 impl SimHandle {
     /// Spawns the thread, idle until a [`SimCommand::Run`].
     pub fn spawn() -> Self {
-        Self::spawn_with_waker(Box::new(|| {}))
+        Self::spawn_with_waker(Box::new(|_| {}))
     }
 
     /// Spawns the thread; it calls `waker` after each message it posts, so that a UI
@@ -695,8 +704,12 @@ struct Outbox {
 
 impl Outbox {
     fn send(&self, msg: SimMessage) -> std::result::Result<(), ()> {
+        let wake = match msg {
+            SimMessage::Finished { .. } | SimMessage::Failed { .. } => Wake::RunEnded,
+            SimMessage::Started { .. } | SimMessage::Frames { .. } => Wake::Progress,
+        };
         let sent = self.tx.send(msg).map_err(|_| ());
-        (self.waker)();
+        (self.waker)(wake);
         sent
     }
 }
@@ -937,6 +950,48 @@ mod tests {
         assert_eq!(times.len(), 6);
         assert_eq!(times[0], 995.0 * 0.01);
         assert_eq!(*times.last().unwrap(), 10.0);
+    }
+
+    /// A UI is woken after every message: at its own pace for a start or new frames, at
+    /// once for the end of a run (a finished replay should not wait for the next paced
+    /// frame).
+    #[test]
+    fn the_end_of_a_run_wakes_at_once_and_progress_at_the_ui_pace() {
+        let (wake_tx, wakes) = channel();
+        let handle = SimHandle::spawn_with_waker(Box::new(move |wake| {
+            let _ = wake_tx.send(wake);
+        }));
+        let config = SimConfig {
+            scene: "two-block".into(),
+            duration: Some(0.3),
+            frame_dt: 0.05,
+            ..SimConfig::default()
+        };
+        assert!(handle.send(SimCommand::Run(Box::new(config))));
+        let mut expected = Vec::new();
+        loop {
+            let msg = handle
+                .messages
+                .recv_timeout(Duration::from_secs(60))
+                .unwrap();
+            let ended = matches!(msg, SimMessage::Finished { .. } | SimMessage::Failed { .. });
+            expected.push(if ended {
+                Wake::RunEnded
+            } else {
+                Wake::Progress
+            });
+            if ended {
+                break;
+            }
+        }
+        let woken: Vec<Wake> = (0..expected.len())
+            .map(|_| wakes.recv_timeout(Duration::from_secs(60)).unwrap())
+            .collect();
+        assert_eq!(woken, expected);
+        assert!(
+            expected.len() >= 3,
+            "a start, frames and the end: {expected:?}"
+        );
     }
 
     /// The thread publishes a started message, frames in time order up to the duration,
