@@ -219,54 +219,21 @@ fn aabb(vertices: &[Point]) -> (Point, Point) {
     (lo, hi)
 }
 
-/// From how many declared pairs on the search is split in two halves searched side by
-/// side (rayon): a wall of 107 blocks (`wall:10`) has 286 pairs, the paper's models one to twelve,
-/// for which the hand-off would cost more than it saves.
-pub(super) const PARALLEL_PAIRS: usize = 256;
-
 /// Finds the vertex-edge contacts of all declared pairs at the current geometry and
 /// carries over the memory of contacts that existed in the previous step.
 ///
 /// `search` is the distance within which a vertex is a candidate: a vertex farther than
 /// that from an edge cannot reach it within one step (the step is limited by the maximum
 /// displacement ratio).
-///
-/// With many pairs (a wall) the second half of the pairs is searched on another thread
-/// into `scratch` and appended: the contacts come out in the same order, so the results
-/// are the same to the bit.
 pub fn detect(
     blocks: &[Block],
     pairs: &[ContactPair],
     memory: &ContactMemories,
     search: f64,
     out: &mut Vec<Contact>,
-    scratch: &mut Vec<Contact>,
 ) {
     out.clear();
-    if pairs.len() < PARALLEL_PAIRS {
-        detect_pairs(blocks, pairs, 0, memory, search, out);
-        return;
-    }
-    let half = pairs.len() / 2;
-    let (first, second) = pairs.split_at(half);
-    scratch.clear();
-    rayon::join(
-        || detect_pairs(blocks, first, 0, memory, search, out),
-        || detect_pairs(blocks, second, half, memory, search, scratch),
-    );
-    out.append(scratch);
-}
-
-/// Appends the contacts of `pairs` (the declared pairs from index `first_pair` on).
-pub(super) fn detect_pairs(
-    blocks: &[Block],
-    pairs: &[ContactPair],
-    first_pair: usize,
-    memory: &ContactMemories,
-    search: f64,
-    out: &mut Vec<Contact>,
-) {
-    for (pair_index, pair) in (first_pair..).zip(pairs) {
+    for (pair_index, pair) in pairs.iter().enumerate() {
         let [a, b] = pair.blocks;
         let (alo, ahi) = aabb(&blocks[a].vertices);
         let (blo, bhi) = aabb(&blocks[b].vertices);

@@ -209,9 +209,6 @@ pub struct Dda {
     /// (the search is a sixth of a large wall's step). Anything that changes the memory,
     /// the geometry or the velocities before that step drops it.
     detection_for_next_step: Option<f64>,
-    /// The second half of a large model's contacts while they are searched on two threads
-    /// (kept to reuse its storage; see `contact::detect`).
-    detection_scratch: Vec<Contact>,
     memory: ContactMemories,
     bolts: Vec<Bolt>,
     fixed: Vec<FixedPoint>,
@@ -467,7 +464,6 @@ impl Dda {
             pairs,
             contacts: Vec::new(),
             spare_contacts: Vec::new(),
-            detection_scratch: Vec::new(),
             detection_for_next_step: None,
             memory: ContactMemories::default(),
             bolts,
@@ -538,7 +534,6 @@ impl Dda {
             &self.memory,
             self.search_distance,
             &mut self.contacts,
-            &mut self.detection_scratch,
         );
         if self.augmented() {
             self.scale_constraint_penalties();
@@ -969,56 +964,4 @@ fn coupling_pattern(
         }
     }
     BlockPattern::new(dofs.n / 6, couplings)
-}
-
-#[cfg(test)]
-mod detection_tests {
-    use super::*;
-
-    /// A large model's contacts are searched in two halves side by side
-    /// (`contact::detect`). They must come out as one pass over all the pairs finds them,
-    /// in the same order: the assembly adds them in that order, so the results keep their
-    /// bits.
-    #[test]
-    fn the_search_in_two_halves_finds_what_one_pass_finds() {
-        let scene = crate::model::generated::wall(10).unwrap();
-        let mut dda = Dda::new(&scene, None, SolverParams::default()).unwrap();
-        for _ in 0..20 {
-            dda.step(dda.params.dt).unwrap();
-        }
-        assert!(dda.pairs.len() >= contact::PARALLEL_PAIRS);
-        let search = dda.search_distance;
-        let mut split = Vec::new();
-        contact::detect(
-            &dda.blocks,
-            &dda.pairs,
-            &dda.memory,
-            search,
-            &mut split,
-            &mut Vec::new(),
-        );
-        let mut one_pass = Vec::new();
-        contact::detect_pairs(
-            &dda.blocks,
-            &dda.pairs,
-            0,
-            &dda.memory,
-            search,
-            &mut one_pass,
-        );
-        assert!(one_pass.len() > 500, "{} contacts", one_pass.len());
-        let identity = |c: &Contact| {
-            (
-                c.key,
-                c.pair,
-                c.gap0.to_bits(),
-                c.start_state,
-                c.shear0.to_bits(),
-                c.start_normal.to_bits(),
-            )
-        };
-        let split: Vec<_> = split.iter().map(identity).collect();
-        let one_pass: Vec<_> = one_pass.iter().map(identity).collect();
-        assert_eq!(split, one_pass);
-    }
 }
