@@ -395,6 +395,13 @@ impl Block {
     /// Moves the block by the step's unknowns `d`: vertices, stress, strain, moments and
     /// mass matrix are updated; velocity and acceleration are set by the integrator.
     pub fn apply_increment(&mut self, d: &Vec6, exact_rotation: bool) -> Result<()> {
+        // A block that did not move and has no speed (the prescribed ground, every step)
+        // keeps its geometry, moments, mass and velocity to the bit: recomputing them
+        // from the same vertices gives the same values, at ~1 200 instructions a block.
+        // (A moving block's velocity transport is not the identity to the bit.)
+        if d.iter().chain(&self.velocity).all(|&x| x == 0.0) {
+            return Ok(());
+        }
         let c = self.moments.centroid;
         // The rotation's sine and cosine once for all vertices.
         let map = StepMap::new(d, exact_rotation);

@@ -60,6 +60,11 @@ impl Dda {
             Mode::Modal => (0.0, 1.0),
         };
         sys.clear(stiffness_factor);
+        // The ground's acceleration at the step's end, once for all blocks.
+        let frame_accel = match mode {
+            Mode::Dynamic { dt } => self.frame_accel(self.time + dt),
+            _ => [0.0; 2],
+        };
         for (bi, b) in self.blocks.iter().enumerate() {
             let Some(s) = self.dofs.slot[bi] else {
                 continue;
@@ -93,7 +98,7 @@ impl Dda {
                 // components when the ground also shakes vertically). The paper's
                 // large-mass ground is driven by f = m_g ü0 (eq. 4), which cancels it.
                 if b.role != BlockRole::LargeMassGround {
-                    let [ax, ay] = self.frame_accel(self.time + dt);
+                    let [ax, ay] = frame_accel;
                     sys.r[s] -= b.total_mass() * ax;
                     sys.r[s + 1] -= b.total_mass() * ay;
                 }
