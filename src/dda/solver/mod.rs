@@ -219,6 +219,9 @@ pub struct Dda {
     motion: Option<GroundMotion>,
     /// The vertical ground motion (up positive), if the ground also shakes vertically.
     vertical: Option<GroundMotion>,
+    /// The frame's acceleration at the last two times asked for (see
+    /// [`Dda::frame_accel`]).
+    frame_accel_memo: FrameAccelMemo,
     /// Rayleigh damping of the structure and its base slab's block index.
     rayleigh: Option<(super::rayleigh::RayleighDamping, usize)>,
     gravity: f64,
@@ -473,6 +476,7 @@ impl Dda {
             loads,
             motion,
             vertical: None,
+            frame_accel_memo: FrameAccelMemo::default(),
             rayleigh: None,
             gravity: scene.gravity,
             coeffs: params.integrator.coefficients(),
@@ -782,7 +786,7 @@ impl Dda {
     /// moves with the ground (see [`Dda::frame_displacement`]), so the ground's
     /// acceleration is added to the block's.
     pub fn absolute_accel(&self, b: usize) -> f64 {
-        self.blocks[b].response_accel[0] + self.ground_accel(self.time)
+        self.blocks[b].response_accel[0] + self.frame_accel(self.time)[0]
     }
 
     /// How far the model's frame has moved with the ground, m: the solver works in a
@@ -796,7 +800,7 @@ impl Dda {
 
     /// Ground acceleration at time t (the input, not the large-mass ground's response).
     pub fn ground_accel(&self, t: f64) -> f64 {
-        self.motion.as_ref().map_or(0.0, |m| m.accel(t))
+        self.frame_accel(t)[0]
     }
 
     /// Vertical ground acceleration at time t, up positive (0 without vertical shaking).
@@ -806,8 +810,20 @@ impl Dda {
 
     /// The ground's acceleration (horizontal, vertical) at time t: in the frame that moves
     /// with the ground every block feels it, reversed, as a body force per unit mass.
+    ///
+    /// A step asks for the same two times several times over (its end in the assembly,
+    /// both ends for the work of the input, its end again for the response written out):
+    /// the last two are kept. A record's or a harmonic's value is a function of the time
+    /// alone, so a kept value is the one computing it again would give, to the bit.
     fn frame_accel(&self, t: f64) -> [f64; 2] {
-        [self.ground_accel(t), self.vertical_ground_accel(t)]
+        self.frame_accel_memo.get(t).unwrap_or_else(|| {
+            let accel = [
+                self.motion.as_ref().map_or(0.0, |m| m.accel(t)),
+                self.vertical_ground_accel(t),
+            ];
+            self.frame_accel_memo.keep(t, accel);
+            accel
+        })
     }
 
     /// Shakes the ground vertically too (`None`: horizontally only), by `motion` (up
@@ -830,6 +846,7 @@ impl Dda {
             ));
         }
         self.vertical = motion;
+        self.frame_accel_memo = FrameAccelMemo::default();
         Ok(())
     }
 
@@ -964,4 +981,55 @@ fn coupling_pattern(
         }
     }
     BlockPattern::new(dofs.n / 6, couplings)
+}
+
+/// The frame's acceleration at the last two times it was computed for: (time, [x, y]).
+/// Interior mutability, because the assembly and the response read it through `&Dda`.
+#[derive(Debug, Clone)]
+struct FrameAccelMemo(std::cell::Cell<[(f64, [f64; 2]); 2]>);
+
+impl Default for FrameAccelMemo {
+    /// Nothing kept (a NaN time equals no time).
+    fn default() -> Self {
+        Self(std::cell::Cell::new([(f64::NAN, [0.0; 2]); 2]))
+    }
+}
+
+impl FrameAccelMemo {
+    /// The value kept for exactly `t`, if any.
+    fn get(&self, t: f64) -> Option<[f64; 2]> {
+        self.0
+            .get()
+            .iter()
+            .find(|(kept, _)| *kept == t)
+            .map(|&(_, a)| a)
+    }
+
+    /// Keeps `accel` for `t` in place of the older of the two.
+    fn keep(&self, t: f64, accel: [f64; 2]) {
+        let [newer, _] = self.0.get();
+        self.0.set([(t, accel), newer]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FrameAccelMemo;
+
+    #[test]
+    fn the_frame_accel_memo_keeps_the_last_two_times_exactly() {
+        let memo = FrameAccelMemo::default();
+        assert_eq!(memo.get(0.0), None, "nothing is kept at first");
+        assert_eq!(memo.get(f64::NAN), None, "a NaN time matches nothing");
+        memo.keep(0.001, [1.0, 2.0]);
+        memo.keep(0.002, [3.0, 4.0]);
+        assert_eq!(memo.get(0.001), Some([1.0, 2.0]));
+        assert_eq!(memo.get(0.002), Some([3.0, 4.0]));
+        // A time one ulp away is another time.
+        assert_eq!(memo.get(f64::from_bits(0.002_f64.to_bits() + 1)), None);
+        memo.keep(0.003, [5.0, 6.0]);
+        assert_eq!(memo.get(0.001), None, "the oldest is dropped");
+        assert_eq!(memo.get(0.002), Some([3.0, 4.0]));
+        assert_eq!(memo.get(0.003), Some([5.0, 6.0]));
+    }
 }
