@@ -219,7 +219,7 @@ pub struct Dda {
     motion: Option<GroundMotion>,
     /// The vertical ground motion (up positive), if the ground also shakes vertically.
     vertical: Option<GroundMotion>,
-    /// The frame's acceleration at the last two times asked for (see
+    /// The frame's acceleration at the last two times a step kept it for (see
     /// [`Dda::frame_accel`]).
     frame_accel_memo: FrameAccelMemo,
     /// Rayleigh damping of the structure and its base slab's block index.
@@ -786,7 +786,7 @@ impl Dda {
     /// moves with the ground (see [`Dda::frame_displacement`]), so the ground's
     /// acceleration is added to the block's.
     pub fn absolute_accel(&self, b: usize) -> f64 {
-        self.blocks[b].response_accel[0] + self.frame_accel(self.time)[0]
+        self.blocks[b].response_accel[0] + self.ground_accel(self.time)
     }
 
     /// How far the model's frame has moved with the ground, m: the solver works in a
@@ -812,18 +812,32 @@ impl Dda {
     /// with the ground every block feels it, reversed, as a body force per unit mass.
     ///
     /// A step asks for the same two times several times over (its end in the assembly,
-    /// both ends for the work of the input, its end again for the response written out):
-    /// the last two are kept. A record's or a harmonic's value is a function of the time
-    /// alone, so a kept value is the one computing it again would give, to the bit.
+    /// both ends for the work of the input, its end again for the response written out),
+    /// so a step keeps its end time's value before its passes ([`Dda::keep_frame_accel`])
+    /// and the previous step's is still kept for its start. A record's or a harmonic's
+    /// value is a function of the time alone, so a kept value is the one computing it
+    /// again would give, to the bit. Readers only read, so `Dda` stays `Sync`.
     fn frame_accel(&self, t: f64) -> [f64; 2] {
-        self.frame_accel_memo.get(t).unwrap_or_else(|| {
-            let accel = [
-                self.motion.as_ref().map_or(0.0, |m| m.accel(t)),
-                self.vertical_ground_accel(t),
-            ];
+        self.frame_accel_memo
+            .get(t)
+            .unwrap_or_else(|| self.compute_frame_accel(t))
+    }
+
+    /// The ground's acceleration at time t, evaluated (see [`Dda::frame_accel`]).
+    fn compute_frame_accel(&self, t: f64) -> [f64; 2] {
+        [
+            self.motion.as_ref().map_or(0.0, |m| m.accel(t)),
+            self.vertical_ground_accel(t),
+        ]
+    }
+
+    /// Keeps the ground's acceleration at time t for the readers of this step (see
+    /// [`Dda::frame_accel`]); a time already kept is not evaluated again.
+    fn keep_frame_accel(&mut self, t: f64) {
+        if self.frame_accel_memo.get(t).is_none() {
+            let accel = self.compute_frame_accel(t);
             self.frame_accel_memo.keep(t, accel);
-            accel
-        })
+        }
     }
 
     /// Shakes the ground vertically too (`None`: horizontally only), by `motion` (up
@@ -983,32 +997,27 @@ fn coupling_pattern(
     BlockPattern::new(dofs.n / 6, couplings)
 }
 
-/// The frame's acceleration at the last two times it was computed for: (time, [x, y]).
-/// Interior mutability, because the assembly and the response read it through `&Dda`.
-#[derive(Debug, Clone)]
-struct FrameAccelMemo(std::cell::Cell<[(f64, [f64; 2]); 2]>);
+/// The frame's acceleration at the last two times kept: (time, [x, y]). A plain value,
+/// written only where the step holds `&mut Dda`, so that `Dda` stays `Sync`.
+#[derive(Debug, Clone, Copy)]
+struct FrameAccelMemo([(f64, [f64; 2]); 2]);
 
 impl Default for FrameAccelMemo {
     /// Nothing kept (a NaN time equals no time).
     fn default() -> Self {
-        Self(std::cell::Cell::new([(f64::NAN, [0.0; 2]); 2]))
+        Self([(f64::NAN, [0.0; 2]); 2])
     }
 }
 
 impl FrameAccelMemo {
     /// The value kept for exactly `t`, if any.
     fn get(&self, t: f64) -> Option<[f64; 2]> {
-        self.0
-            .get()
-            .iter()
-            .find(|(kept, _)| *kept == t)
-            .map(|&(_, a)| a)
+        self.0.iter().find(|(kept, _)| *kept == t).map(|&(_, a)| a)
     }
 
     /// Keeps `accel` for `t` in place of the older of the two.
-    fn keep(&self, t: f64, accel: [f64; 2]) {
-        let [newer, _] = self.0.get();
-        self.0.set([(t, accel), newer]);
+    fn keep(&mut self, t: f64, accel: [f64; 2]) {
+        self.0 = [(t, accel), self.0[0]];
     }
 }
 
@@ -1018,7 +1027,7 @@ mod tests {
 
     #[test]
     fn the_frame_accel_memo_keeps_the_last_two_times_exactly() {
-        let memo = FrameAccelMemo::default();
+        let mut memo = FrameAccelMemo::default();
         assert_eq!(memo.get(0.0), None, "nothing is kept at first");
         assert_eq!(memo.get(f64::NAN), None, "a NaN time matches nothing");
         memo.keep(0.001, [1.0, 2.0]);
@@ -1031,5 +1040,13 @@ mod tests {
         assert_eq!(memo.get(0.001), None, "the oldest is dropped");
         assert_eq!(memo.get(0.002), Some([3.0, 4.0]));
         assert_eq!(memo.get(0.003), Some([5.0, 6.0]));
+    }
+
+    /// A solver can be shared between threads by reference (a study reading one model
+    /// from several threads), so it keeps no interior mutability.
+    #[test]
+    fn the_solver_is_send_and_sync() {
+        fn shareable<T: Send + Sync>() {}
+        shareable::<super::Dda>();
     }
 }

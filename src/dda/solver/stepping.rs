@@ -212,6 +212,7 @@ impl Dda {
                 self.undo_release(before);
             }
             let mode = Mode::Dynamic { dt };
+            self.keep_frame_accel(self.time + dt);
             let known = self.known_increments();
             self.detect_contacts();
             self.stiffen_constraints_for(dt);
