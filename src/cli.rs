@@ -787,6 +787,11 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         "  peak base accel       {:.4} g  (ground {:.4} g)",
         s.peak_base_accel_g, s.peak_ground_accel_g
     ))?;
+    if let (Some(roof), Some(base)) = (s.peak_roof_accel_25hz_g, s.peak_base_accel_25hz_g) {
+        out(&format!(
+            "  low-passed at 25 Hz   roof {roof:.4} g, base {base:.4} g"
+        ))?;
+    }
     out(&format!(
         "  peak roof drift       {:.4e} m",
         s.peak_roof_drift_m

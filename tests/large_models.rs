@@ -106,6 +106,51 @@ fn dry_stacked_walls_ride_out_the_whole_kobe_record() {
     }
 }
 
+/// A wall's acceleration peaks low-passed at 25 Hz are a property of the model, not of
+/// the step: with Δt halved and the dissipative integrator swapped for the trapezoidal
+/// rule they agree within 10 % (measured: 0.100 and 0.101 g at the base), while the raw
+/// peaks, spikes of one to three steps at impacts and stick events, moved 0.22 → 0.37 g.
+/// Each low-passed peak is at most its raw one (the filter's weights are positive).
+#[test]
+#[ignore = "slow: release runs of a wall under Kobe"]
+fn a_walls_low_passed_peaks_hold_across_step_sizes_and_integrators() {
+    use slidebase::dda::Integrator;
+    let run = |dt: f64, integrator: Integrator| {
+        let spec = RunSpec {
+            excitation: ExcitationSpec::Record {
+                source: "kobe-nishi-akashi-000".into(),
+                scale: 1.0,
+            },
+            duration: Some(12.0),
+            dt: Some(dt),
+            integrator: Some(integrator),
+            ..RunSpec::scene("wall:5")
+        };
+        run_frame(&spec).unwrap().summary
+    };
+    let coarse = run(1e-3, Integrator::GeneralizedAlpha { rho_inf: 0.0 });
+    let fine = run(5e-4, Integrator::Trapezoidal);
+    for s in [&coarse, &fine] {
+        assert!(s.peak_base_accel_25hz_g.unwrap() <= s.peak_base_accel_g);
+        assert!(s.peak_roof_accel_25hz_g.unwrap() <= s.peak_roof_accel_g);
+    }
+    for (name, a, b) in [
+        (
+            "base",
+            coarse.peak_base_accel_25hz_g,
+            fine.peak_base_accel_25hz_g,
+        ),
+        (
+            "roof",
+            coarse.peak_roof_accel_25hz_g,
+            fine.peak_roof_accel_25hz_g,
+        ),
+    ] {
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert!((a / b - 1.0).abs() < 0.1, "{name}: {a} g against {b} g");
+    }
+}
+
 /// A long run tells how far it has come: the reporter is called with times that grow to
 /// the run's end.
 #[test]

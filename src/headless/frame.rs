@@ -58,6 +58,14 @@ pub struct FrameSummary {
     pub peak_roof_accel_g: f64,
     /// Peak |absolute base acceleration|, g.
     pub peak_base_accel_g: f64,
+    /// Peak |absolute roof acceleration| low-passed at 25 Hz, g (DDA): robust to the
+    /// one-step spikes of impacts and stick events, whose heights depend on Δt and on the
+    /// solver's path (see [`crate::post::filter`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_roof_accel_25hz_g: Option<f64>,
+    /// Peak |absolute base acceleration| low-passed at 25 Hz, g (DDA).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_base_accel_25hz_g: Option<f64>,
     /// Peak ground acceleration, g.
     pub peak_ground_accel_g: f64,
     /// Peak |roof displacement relative to the base|, m.
@@ -171,6 +179,8 @@ fn summarise(
         peak
     });
     let p = &run.peaks;
+    let low_passed = run.low_passed;
+    let in_g = |a: f64| a / STANDARD_GRAVITY;
     Ok(FrameSummary {
         scene: setup.scene.name.clone(),
         model: model.label().into(),
@@ -186,6 +196,8 @@ fn summarise(
         residual_slip_m: run.residual_slip_m,
         peak_roof_accel_g: p.roof_accel / STANDARD_GRAVITY,
         peak_base_accel_g: p.base_accel / STANDARD_GRAVITY,
+        peak_roof_accel_25hz_g: low_passed.and_then(|l| l.roof_accel).map(in_g),
+        peak_base_accel_25hz_g: low_passed.and_then(|l| l.base_accel).map(in_g),
         peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
         peak_roof_drift_m: p.drift_m,
         base_accel_peak_freq_hz: peak_freq,

@@ -9,6 +9,7 @@ use crate::dda::{CutReasons, SolverParams};
 use crate::ground_motion::GroundMotion;
 use crate::limits::MAX_HISTORY_ROWS;
 use crate::model::Scene;
+use crate::post::filter::{self, CellAverages};
 use crate::post::history::{History, PeakTracker};
 use crate::post::spectrum::UniformSeries;
 use crate::setup::{ModelKind, RunProgress, RunSetup};
@@ -65,6 +66,19 @@ pub struct ModelRun {
     /// The base acceleration resampled every [`SPECTRUM_DT`] seconds, for its spectrum
     /// (DDA only).
     pub base_accel_series: Option<UniformSeries>,
+    /// Peaks of the absolute base and roof accelerations low-passed at 25 Hz (DDA only;
+    /// see [`crate::post::filter`]).
+    pub low_passed: Option<LowPassedPeaks>,
+}
+
+/// Peaks of accelerations low-passed at [`crate::post::filter::CUTOFF_HZ`], m/s² (`None`
+/// when the run is too short to filter).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LowPassedPeaks {
+    /// Absolute base acceleration.
+    pub base_accel: Option<f64>,
+    /// Absolute roof acceleration.
+    pub roof_accel: Option<f64>,
 }
 
 /// Columns of the recorded history.
@@ -96,6 +110,8 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
     let mut peaks = [PeakTracker::default(); 5];
     let mut history = History::new(&HISTORY_COLUMNS);
     let mut series = UniformSeries::new(SPECTRUM_DT, SPECTRUM_MAX_SAMPLES);
+    let mut base_cells = CellAverages::new(filter::CELL_S, filter::MAX_CELLS);
+    let mut roof_cells = base_cells.clone();
     let mut step = 0usize;
     let mut last_slip = 0.0;
     // The last step's row when the stride skipped it: a history ends where the run ends
@@ -138,6 +154,8 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
             p.offer(r.time, row[k + 1]);
         }
         series.push(r.time, r.base_accel);
+        base_cells.push(r.time, r.base_accel);
+        roof_cells.push(r.time, r.roof_accel);
         if record_every > 0 && step.is_multiple_of(record_every) {
             history.push(&row);
             unrecorded = None;
@@ -181,6 +199,10 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         wall_time_s: start.elapsed().as_secs_f64(),
         history,
         base_accel_series: Some(series),
+        low_passed: Some(LowPassedPeaks {
+            base_accel: base_cells.low_passed_peak(),
+            roof_accel: roof_cells.low_passed_peak(),
+        }),
     })
 }
 
@@ -289,6 +311,7 @@ impl ModelRun {
             wall_time_s: start.elapsed().as_secs_f64(),
             history,
             base_accel_series: None,
+            low_passed: None,
         }
     }
 }

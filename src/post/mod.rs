@@ -1,6 +1,7 @@
 //! Post-processing: recorded time histories, spectra, the sweep table, figures, and the
 //! all-or-nothing output folders they are written to.
 
+pub mod filter;
 pub mod history;
 pub mod output;
 pub mod plot;
