@@ -666,6 +666,15 @@ fn a_run_shorter_than_two_spectrum_samples_is_not_an_error() {
     .unwrap();
     assert!(o.summary.base_accel_peak_freq_hz.is_none());
     assert!(o.summary.warnings.iter().any(|w| w.contains("too short")));
+    // Nor too short to low-pass: the low-passed peaks are left out, and the warnings say so.
+    assert!(o.summary.peak_base_accel_25hz_g.is_none());
+    assert!(o.summary.peak_roof_accel_25hz_g.is_none());
+    assert!(
+        o.summary
+            .warnings
+            .iter()
+            .any(|w| w.contains("too short to low-pass") && w.contains("25hz"))
+    );
 }
 
 // ---- valid input, clear limits ----------------------------------------------------------

@@ -180,6 +180,14 @@ fn summarise(
     });
     let p = &run.peaks;
     let low_passed = run.low_passed;
+    if low_passed.is_some_and(|l| l.base_accel.is_none() || l.roof_accel.is_none()) {
+        warnings.push(format!(
+            "the run ({} s) is too short to low-pass its accelerations (two {} ms cells at \
+             least): peak_roof_accel_25hz_g and peak_base_accel_25hz_g are left out",
+            setup.duration,
+            crate::post::filter::CELL_S * 1e3
+        ));
+    }
     let in_g = |a: f64| a / STANDARD_GRAVITY;
     Ok(FrameSummary {
         scene: setup.scene.name.clone(),
