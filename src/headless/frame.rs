@@ -180,7 +180,7 @@ fn summarise(
     });
     let p = &run.peaks;
     let low_passed = run.low_passed;
-    if low_passed.is_some_and(|l| l.base_accel.is_none() || l.roof_accel.is_none()) {
+    if model == ModelKind::Dda && low_passed.is_none() {
         warnings.push(format!(
             "the run ({} s) is too short to low-pass its accelerations (two {} ms cells at \
              least): peak_roof_accel_25hz_g and peak_base_accel_25hz_g are left out",
@@ -204,8 +204,8 @@ fn summarise(
         residual_slip_m: run.residual_slip_m,
         peak_roof_accel_g: p.roof_accel / STANDARD_GRAVITY,
         peak_base_accel_g: p.base_accel / STANDARD_GRAVITY,
-        peak_roof_accel_25hz_g: low_passed.and_then(|l| l.roof_accel).map(in_g),
-        peak_base_accel_25hz_g: low_passed.and_then(|l| l.base_accel).map(in_g),
+        peak_roof_accel_25hz_g: low_passed.map(|l| in_g(l.roof_accel)),
+        peak_base_accel_25hz_g: low_passed.map(|l| in_g(l.base_accel)),
         peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
         peak_roof_drift_m: p.drift_m,
         base_accel_peak_freq_hz: peak_freq,

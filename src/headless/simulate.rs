@@ -66,19 +66,18 @@ pub struct ModelRun {
     /// The base acceleration resampled every [`SPECTRUM_DT`] seconds, for its spectrum
     /// (DDA only).
     pub base_accel_series: Option<UniformSeries>,
-    /// Peaks of the absolute base and roof accelerations low-passed at 25 Hz (DDA only;
-    /// see [`crate::post::filter`]).
+    /// Peaks of the absolute base and roof accelerations low-passed at 25 Hz (DDA only,
+    /// and only when the run is long enough to filter; see [`crate::post::filter`]).
     pub low_passed: Option<LowPassedPeaks>,
 }
 
-/// Peaks of accelerations low-passed at [`crate::post::filter::CUTOFF_HZ`], m/s² (`None`
-/// when the run is too short to filter).
+/// Peaks of accelerations low-passed at [`crate::post::filter::CUTOFF_HZ`], m/s².
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LowPassedPeaks {
     /// Absolute base acceleration.
-    pub base_accel: Option<f64>,
+    pub base_accel: f64,
     /// Absolute roof acceleration.
-    pub roof_accel: Option<f64>,
+    pub roof_accel: f64,
 }
 
 /// Columns of the recorded history.
@@ -199,10 +198,13 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         wall_time_s: start.elapsed().as_secs_f64(),
         history,
         base_accel_series: Some(series),
-        low_passed: Some(LowPassedPeaks {
-            base_accel: base_cells.low_passed_peak(),
-            roof_accel: roof_cells.low_passed_peak(),
-        }),
+        low_passed: base_cells
+            .low_passed_peak()
+            .zip(roof_cells.low_passed_peak())
+            .map(|(base_accel, roof_accel)| LowPassedPeaks {
+                base_accel,
+                roof_accel,
+            }),
     })
 }
 
