@@ -140,22 +140,36 @@ fn gaussian_kernel(cutoff_hz: f64, dt: f64) -> Option<Vec<f64>> {
 /// `x` smoothed by the symmetric kernel `half` (centre weight first): each value is the
 /// weighted mean of its neighbours, the weights normalised over those that exist (near
 /// the ends, fewer), so every result is a convex combination of the samples.
+///
+/// Summed offset by offset over the whole series (each pass a plain multiply-add over
+/// two slices, which vectorises) rather than cell by cell with a bounds test per term:
+/// this runs after every building and two-block run, and cell by cell it was ~5 % of
+/// the two-block's 100 s run.
 fn smooth(x: &[f64], half: &[f64]) -> Vec<f64> {
-    let n = x.len() as isize;
-    (0..n)
-        .map(|i| {
-            let (mut sum, mut weight) = (half[0] * x[i as usize], half[0]);
-            for (k, &w) in half.iter().enumerate().skip(1) {
-                for j in [i - k as isize, i + k as isize] {
-                    if (0..n).contains(&j) {
-                        sum += w * x[j as usize];
-                        weight += w;
-                    }
-                }
-            }
-            sum / weight
-        })
-        .collect()
+    let n = x.len();
+    let mut sum: Vec<f64> = x.iter().map(|v| half[0] * v).collect();
+    for (k, &w) in half.iter().enumerate().skip(1).take_while(|&(k, _)| k < n) {
+        // Cell i takes x[i − k] and x[i + k] where they exist.
+        for (s, v) in sum[k..].iter_mut().zip(&x[..n - k]) {
+            *s += w * v;
+        }
+        for (s, v) in sum[..n - k].iter_mut().zip(&x[k..]) {
+            *s += w * v;
+        }
+    }
+    // A cell m from the nearer end lacks the weights of the offsets beyond m on that side.
+    let total = half[0] + 2.0 * half[1..].iter().sum::<f64>();
+    let missing = |m: usize| half.get(m + 1..).map_or(0.0, |t| t.iter().sum::<f64>());
+    for (i, s) in sum.iter_mut().enumerate() {
+        let (left, right) = (i, n - 1 - i);
+        let weight = if left + 1 >= half.len() && right + 1 >= half.len() {
+            total
+        } else {
+            total - missing(left) - missing(right)
+        };
+        *s /= weight;
+    }
+    sum
 }
 
 #[cfg(test)]
@@ -287,6 +301,32 @@ mod tests {
         assert_eq!(cells.cells().len(), 2);
         assert!((cells.cells()[0] - 2.0).abs() < 1e-12);
         assert!((cells.cells()[1] - 6.0).abs() < 1e-12);
+    }
+
+    /// The offset-by-offset sums are the weighted means of the definition, cell by cell,
+    /// with the weights renormalised near the ends: series shorter than the kernel, as
+    /// long as it, and much longer.
+    #[test]
+    fn smoothing_is_the_normalised_weighted_mean_of_each_cell() {
+        let half = gaussian_kernel(CUTOFF_HZ, CELL_S).unwrap();
+        for n in [1, 2, 5, half.len(), 2 * half.len() + 1, 300] {
+            let x: Vec<f64> = (0..n).map(|i| ((i * 37 % 11) as f64 - 4.0) * 0.7).collect();
+            let y = smooth(&x, &half);
+            for (i, yi) in y.iter().enumerate() {
+                let (mut sum, mut weight) = (0.0, 0.0);
+                for (j, xj) in x.iter().enumerate() {
+                    if let Some(w) = half.get(i.abs_diff(j)) {
+                        sum += w * xj;
+                        weight += w;
+                    }
+                }
+                assert!(
+                    (yi - sum / weight).abs() < 1e-14,
+                    "n {n}, cell {i}: {yi} vs {}",
+                    sum / weight
+                );
+            }
+        }
     }
 
     #[test]
