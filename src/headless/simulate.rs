@@ -12,7 +12,7 @@ use crate::model::Scene;
 use crate::post::filter::{self, CellAverages};
 use crate::post::history::{History, PeakTracker};
 use crate::post::spectrum::UniformSeries;
-use crate::setup::{ModelKind, RunProgress, RunSetup};
+use crate::setup::{ModelKind, RemainingTime, RunProgress, RunSetup};
 
 /// Peak responses of a run, SI units.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
@@ -118,6 +118,8 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
     let mut unrecorded = None;
     let mut sliding_steps = 0;
     let mut next_report = setup.progress.as_ref().map(|p| p.first_after_s);
+    // Built at the first report: a run that never reports never samples its motion.
+    let mut remaining: Option<RemainingTime> = None;
     dda.run_until(duration, |d, report| {
         // The clock is read every 16 steps (~40 µs of the smallest model; a large wall
         // under strong shaking takes seconds for them).
@@ -127,12 +129,15 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
             let elapsed_s = start.elapsed().as_secs_f64();
             if elapsed_s >= *due {
                 *due = elapsed_s + reporter.every_s;
+                let estimate =
+                    remaining.get_or_insert_with(|| RemainingTime::new(motion, duration));
                 reporter.report(&RunProgress {
                     time_s: report.time,
                     duration_s: duration,
                     steps: step as u64,
                     cuts: d.counters().cuts,
                     elapsed_s,
+                    remaining_s: estimate.observe(report.time, elapsed_s),
                 });
             }
         }

@@ -18,7 +18,7 @@ mod spec;
 
 pub use check::{check_steps, exact_steps_for};
 pub use prepare::{RunSetup, SceneRoles};
-pub use progress::{ProgressReporter, RunProgress};
+pub use progress::{ProgressReporter, RemainingTime, RunProgress};
 pub use response::{Probe, Response};
 pub use spec::{
     ExcitationSpec, Frequency, HistoryPlan, ModelKind, RunSpec, SceneSource, VerticalSpec,
