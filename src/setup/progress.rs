@@ -54,8 +54,8 @@ impl fmt::Display for RunProgress {
     }
 }
 
-/// Most points of the shaking's running integral kept (2¹⁶: a point every 0.6 ms of a
-/// 41 s record; a longer run spaces them wider).
+/// Most points of the shaking's running integral kept (2¹⁶: 1 ms apart up to 65 s of
+/// run; a longer run spaces them wider).
 const MAX_INTENSITY_POINTS: usize = 1 << 16;
 
 /// Spacing of the running integral's points, s (a record's own sampling is 5–20 ms).
@@ -166,8 +166,10 @@ impl RemainingTime {
             }
         }
         // Each one-variable fit leaves Σe² − (Σx·e)²/Σx²: the larger (Σx·e)²/Σx² fits better.
+        // A tie (a single report, where both fit exactly) is the pace: by J alone, a first
+        // report in a calm start would promise the strong motion at the calm pace.
         let by_time = (ste.max(0.0) / stt, 0.0);
-        if sjj > 0.0 && sje * sje / sjj > ste * ste / stt {
+        if sjj > 0.0 && sje * sje / sjj > (1.0 + 1e-9) * (ste * ste / stt) {
             return Some((0.0, sje.max(0.0) / sjj));
         }
         Some(by_time)
@@ -261,6 +263,11 @@ mod tests {
         for t in [0.5, 1.0, 1.9] {
             let e = elapsed(&estimate, t);
             let left = estimate.observe(t, e).unwrap();
+            if t == 0.5 {
+                // One report cannot tell the terms apart: the pace.
+                let pace = e * (3.0 - t) / t;
+                assert!((left - pace).abs() < 1e-12 * pace, "{left} vs {pace}");
+            }
             if t == 1.9 {
                 let truth = elapsed(&estimate, 3.0) - e;
                 assert!((left - truth).abs() < 1e-9 * truth, "{left} vs {truth}");
