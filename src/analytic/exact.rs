@@ -874,3 +874,59 @@ fn stored_energy(b: &ShearBuilding, ground: &GroundMotion, state: &Snapshot) -> 
     }
     (kinetic, strain)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A two-mode system (ω² = 2 ± √2 for unit masses and springs in a chain).
+    fn two_modes() -> PhaseSystem {
+        let m = DMatrix::identity(2, 2);
+        let k = DMatrix::from_row_slice(2, 2, &[2.0, -1.0, -1.0, 1.0]);
+        let b = DVector::from_element(2, -1.0);
+        PhaseSystem::new(m, &k, &b, &DVector::zeros(2)).unwrap()
+    }
+
+    /// A kept step length holds what a propagation would compute from it afresh, a hit
+    /// hands back those values, and past [`STEP_TRIG_SLOTS`] lengths the oldest is
+    /// replaced (and computed again, to the same bits, when it comes back).
+    #[test]
+    fn kept_step_trigonometry_is_what_the_step_would_compute() {
+        let sys = two_modes();
+        let (x, w) = gauss_legendre(10);
+        let quad = (x.as_slice(), w.as_slice());
+        let mut cache = StepTrigCache::default();
+        let tau = 0.0123;
+        let first = cache.get(tau, false, &sys, quad);
+        for (j, &omega) in sys.modal.omega.iter().enumerate() {
+            let (sn, cs) = (omega * tau).sin_cos();
+            assert_eq!(first.modes[j], (sn, cs, sin_cos_over(omega, tau).0));
+            for (i, (&xi, &wi)) in x.iter().zip(&w).enumerate() {
+                let s = 0.5 * tau * (1.0 + xi);
+                assert_eq!(first.nodes[i], (s, 0.5 * tau * wi));
+                assert_eq!(first.kernel[j * x.len() + i], sin_cos_over(omega, tau - s));
+            }
+        }
+        let kept = (first.modes.clone(), first.kernel.clone());
+        assert_eq!(cache.slots.len(), 1);
+        let again = cache.get(tau, false, &sys, quad);
+        assert_eq!((again.modes.clone(), again.kernel.clone()), kept);
+        assert_eq!(cache.slots.len(), 1, "a hit adds no slot");
+        // The other phase's system is another entry, even for the same length.
+        cache.get(tau, true, &sys, quad);
+        assert_eq!(cache.slots.len(), 2);
+        for k in 1..STEP_TRIG_SLOTS {
+            cache.get(tau * (1.0 + k as f64), false, &sys, quad);
+        }
+        assert_eq!(cache.slots.len(), STEP_TRIG_SLOTS);
+        assert!(
+            !cache
+                .slots
+                .iter()
+                .any(|e| e.tau_bits == tau.to_bits() && !e.slip),
+            "the oldest length was replaced"
+        );
+        let back = cache.get(tau, false, &sys, quad);
+        assert_eq!((back.modes.clone(), back.kernel.clone()), kept);
+    }
+}
