@@ -34,7 +34,10 @@ where the base started (it moves with the ground), the red arrow is the slip.
 
 Colours: blocks by strain (blue small, red large); contact springs blue when stuck, orange \
 when sliding, grey when open. The headline compares the peak roof acceleration of the first \
-model with the last one's. The plots on the right follow the time cursor.
+model with the last one's. The plots on the right follow the time cursor. Where blocks hit \
+or a base sticks, an acceleration can spike for a step or two; its height then depends on \
+the time step, so the legend also gives the peak low-passed at 25 Hz, as a shake-table \
+accelerometer would read it.
 
 The numbers come from Discontinuous Deformation Analysis (DDA): every block moves and deforms, \
 contacts are springs that stick, slide or open, checked against the exact solution of the \

@@ -25,7 +25,9 @@ use crate::sim::{
     ExactOverlay, Excitation, FrameSet, MotionInfo, Samples, SimCommand, SimConfig, SimMessage,
 };
 
-pub use plots::{Curve, MODEL_COLORS, PlotData, model_color, spectrum_of, write_plot_data};
+pub use plots::{
+    Curve, MODEL_COLORS, PlotData, accel_legend, model_color, spectrum_of, write_plot_data,
+};
 
 /// The scenes offered in the panel.
 #[derive(Debug, Clone, PartialEq)]
