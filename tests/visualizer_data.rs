@@ -50,19 +50,17 @@ fn spectrum_of_a_1_hz_harmonic_peaks_at_1_hz() {
     assert!((half.spectrum_peaks[0] - 1.0).abs() <= 0.1);
 }
 
-/// El Centro on the three-storey frame: the base acceleration's spectral peak in the plots
-/// is `run --json`'s `base_accel_peak_freq_hz` within one frequency bin (it was 9.48 Hz
-/// against 2.14 Hz).
-#[test]
-fn el_centro_spectrum_peak_agrees_with_run_json() {
-    let duration = 31.0;
+/// The three-storey frame on ρ = 0.01 under `duration` s of El Centro, run headless
+/// (`run --json`'s summary) and in the visualizer (its plots at the end), sliding base only.
+fn three_storey_json_and_plots(
+    duration: f64,
+) -> (slidebase::headless::frame::FrameSummary, PlotData) {
     let headless = slidebase::headless::frame::run_frame(&slidebase::setup::RunSpec {
         friction: Some(0.01),
         duration: Some(duration),
         ..slidebase::setup::RunSpec::scene("three-storey")
     })
     .unwrap();
-    let expected = headless.summary.base_accel_peak_freq_hz.unwrap();
     let config = SimConfig {
         scene: "three-storey".into(),
         friction: Some(0.01),
@@ -71,7 +69,20 @@ fn el_centro_spectrum_peak_agrees_with_run_json() {
         ..SimConfig::default()
     };
     let state = state_until(&config, duration, &PictureOptions::default()).unwrap();
-    let data = PlotData::of(&state.timeline, duration, false);
+    (
+        headless.summary,
+        PlotData::of(&state.timeline, duration, false),
+    )
+}
+
+/// El Centro on the three-storey frame: the base acceleration's spectral peak in the plots
+/// is `run --json`'s `base_accel_peak_freq_hz` within one frequency bin (it was 9.48 Hz
+/// against 2.14 Hz).
+#[test]
+fn el_centro_spectrum_peak_agrees_with_run_json() {
+    let duration = 31.0;
+    let (summary, data) = three_storey_json_and_plots(duration);
+    let expected = summary.base_accel_peak_freq_hz.unwrap();
     let k = data
         .spectrum
         .iter()
@@ -414,23 +425,8 @@ fn frames_advanced_in_chunks_equal_frames_advanced_one_by_one() {
 /// legend shows the raw peak alone.
 #[test]
 fn the_low_passed_roof_peak_agrees_with_run_json() {
-    let duration = 8.0;
-    let headless = slidebase::headless::frame::run_frame(&slidebase::setup::RunSpec {
-        friction: Some(0.01),
-        duration: Some(duration),
-        ..slidebase::setup::RunSpec::scene("three-storey")
-    })
-    .unwrap();
-    let expected = headless.summary.peak_roof_accel_25hz_g.unwrap();
-    let config = SimConfig {
-        scene: "three-storey".into(),
-        friction: Some(0.01),
-        compare_fixed: false,
-        duration: Some(duration),
-        ..SimConfig::default()
-    };
-    let state = state_until(&config, duration, &PictureOptions::default()).unwrap();
-    let data = PlotData::of(&state.timeline, duration, false);
+    let (summary, data) = three_storey_json_and_plots(8.0);
+    let expected = summary.peak_roof_accel_25hz_g.unwrap();
     let roof = data
         .accel
         .iter()
