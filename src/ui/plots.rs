@@ -61,7 +61,7 @@ pub struct Curve {
 /// A low-passed peak this far below the raw one is worth a mention in the legend: the
 /// raw peak is then a spike one to three steps wide (an impact, a base that sticks), whose
 /// height depends on the step size (docs/performance.md, stop 47). On the three-storey
-/// the two differ by 1 %; on a block wall by a factor of four.
+/// the two differ by 1 %; on a block wall by a factor of two to five.
 const SPIKY: f64 = 0.9;
 
 /// Legend text of an acceleration curve, g: its peak, and the low-passed one when the raw
