@@ -269,13 +269,13 @@ struct StepTrig {
     /// (s, weight) of each quadrature node.
     nodes: SmallVec<[(f64, f64); 16]>,
     /// (sin ωτ, cos ωτ, sin(ωτ)/ω) per mode.
-    modes: StateVec3,
+    modes: ModeTrigs,
     /// (sin ω(τ − s)/ω, cos ω(τ − s)), mode-major.
     kernel: Vec<(f64, f64)>,
 }
 
 /// Per-mode triples, inline up to eight modes.
-type StateVec3 = SmallVec<[(f64, f64, f64); 8]>;
+type ModeTrigs = SmallVec<[(f64, f64, f64); 8]>;
 
 /// The last [`STEP_TRIG_SLOTS`] step lengths' [`StepTrig`], replaced in turn.
 #[derive(Default)]
