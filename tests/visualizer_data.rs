@@ -450,3 +450,35 @@ fn the_low_passed_roof_peak_agrees_with_run_json() {
     };
     assert!(slidebase::ui::accel_legend(&spiky).contains("low-passed at 25 Hz"));
 }
+
+/// The plots' kept data is what they would compute afresh: kept while nothing changes (no
+/// work on a replay's frames), recomputed as the run grows, and its spectra cut again when
+/// they follow a moving cursor.
+#[test]
+fn kept_plot_data_is_what_the_plots_would_compute() {
+    use slidebase::ui::PlotCache;
+    use std::sync::Arc;
+    let config = SimConfig::default();
+    let short = state_until(&config, 1.0, &PictureOptions::default()).unwrap();
+    let long = state_until(&config, 1.5, &PictureOptions::default()).unwrap();
+    let mut cache = PlotCache::default();
+    let first = cache.get(&short.timeline, 0.5, false);
+    assert_eq!(*first, PlotData::of(&short.timeline, 0.5, false));
+    // A replay: the cursor moves, the run does not; the same data, not a copy.
+    let again = cache.get(&short.timeline, 0.8, false);
+    assert!(Arc::ptr_eq(&first, &again), "the kept data was recomputed");
+    // The run grew.
+    let grown = cache.get(&long.timeline, 0.8, false);
+    assert_eq!(*grown, PlotData::of(&long.timeline, 0.8, false));
+    assert_ne!(*grown, *first);
+    // Spectra up to a moving cursor: cut again at each cursor, the time curves kept.
+    let at_06 = cache.get(&long.timeline, 0.6, true);
+    assert_eq!(*at_06, PlotData::of(&long.timeline, 0.6, true));
+    let at_12 = cache.get(&long.timeline, 1.2, true);
+    assert_eq!(*at_12, PlotData::of(&long.timeline, 1.2, true));
+    assert_ne!(at_06.spectrum, at_12.spectrum);
+    assert_eq!(at_06.accel, at_12.accel);
+    // Back to the spectra over everything computed.
+    let whole = cache.get(&long.timeline, 1.2, false);
+    assert_eq!(*whole, PlotData::of(&long.timeline, 1.2, false));
+}

@@ -26,7 +26,8 @@ use crate::sim::{
 };
 
 pub use plots::{
-    Curve, MODEL_COLORS, PlotData, accel_legend, model_color, spectrum_of, write_plot_data,
+    Curve, MODEL_COLORS, PlotCache, PlotData, accel_legend, model_color, spectrum_of,
+    write_plot_data,
 };
 
 /// The scenes offered in the panel.
@@ -464,6 +465,8 @@ pub struct AppState {
     /// The preset last chosen (its name), until the controls change.
     pub preset: Option<&'static str>,
     fits: Option<(u64, usize, f32, Vec<Fit>)>,
+    /// The plots' curves, kept between frames (see [`PlotCache`]).
+    plot_cache: PlotCache,
     /// [`AppState::color_max`] of (run generation, colour measure) over the first frames.
     color_max: Option<((u64, crate::render::geometry::ColorBy), usize, f32)>,
     laid_out: bool,
@@ -499,6 +502,7 @@ impl AppState {
             widget_rects: Default::default(),
             preset: None,
             fits: None,
+            plot_cache: PlotCache::default(),
             color_max: None,
             laid_out: false,
             outbox: Vec::new(),

@@ -40,7 +40,7 @@ pub fn model_color(k: usize) -> egui::Color32 {
 }
 
 /// One plotted curve.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Curve {
     /// Legend name (also the CSV column name).
     pub name: String,
@@ -99,7 +99,7 @@ pub fn spectrum_of(
 }
 
 /// Everything the plots show at one time cursor, as curves.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlotData {
     /// Accelerations, g, against time.
     pub accel: Vec<Curve>,
@@ -161,6 +161,13 @@ impl PlotData {
     /// The curves of everything computed in `timeline` (the plots mark the cursor with a
     /// line); the spectra over everything computed or only up to `cursor` (`to_cursor`).
     pub fn of(timeline: &super::Timeline, cursor: f64, to_cursor: bool) -> Self {
+        let mut d = Self::time_histories(timeline);
+        d.add_spectra(timeline, cursor, to_cursor);
+        d
+    }
+
+    /// The time histories alone (no spectra).
+    fn time_histories(timeline: &super::Timeline) -> Self {
         let labels = &timeline.labels;
         let mut d = PlotData::default();
         let Some(main) = timeline.samples.first() else {
@@ -238,7 +245,18 @@ impl PlotData {
                 Some(EXACT),
             )));
         }
-        // Spectra: the ground, then each model's base.
+        d
+    }
+
+    /// Replaces the spectra: the ground's, then each model's base (over everything
+    /// computed, or only up to `cursor`).
+    fn add_spectra(&mut self, timeline: &super::Timeline, cursor: f64, to_cursor: bool) {
+        self.spectrum.clear();
+        self.spectrum_peaks.clear();
+        let Some(main) = timeline.samples.first() else {
+            return;
+        };
+        let d = self;
         let until = if to_cursor { cursor } else { f64::INFINITY };
         let mut add_spectrum =
             |name: String, s: &Samples, col: fn(&Samples) -> &Vec<f64>, color| {
@@ -261,7 +279,7 @@ impl PlotData {
             };
         add_spectrum("ground".into(), main, |s| &s.ground_accel, None);
         for (k, s) in timeline.samples.iter().enumerate() {
-            let label = labels.get(k).cloned().unwrap_or_default();
+            let label = timeline.labels.get(k).cloned().unwrap_or_default();
             add_spectrum(
                 format!("base, {label}"),
                 s,
@@ -269,7 +287,60 @@ impl PlotData {
                 Some(model_color(k)),
             );
         }
-        d
+    }
+}
+
+/// What the plots' curves depend on: the run and how much of it has been computed
+/// (samples are only ever appended to a run, frames too).
+#[derive(Debug, Clone, PartialEq)]
+struct DataKey {
+    generation: u64,
+    frames: usize,
+    samples: Vec<usize>,
+}
+
+impl DataKey {
+    fn of(timeline: &super::Timeline) -> Self {
+        Self {
+            generation: timeline.generation,
+            frames: timeline.frames.len(),
+            samples: timeline.samples.iter().map(Samples::len).collect(),
+        }
+    }
+}
+
+/// [`PlotData`] kept between frames: a replay redraws ~20–60 times a second, and every
+/// redraw thinned each curve, low-passed each roof and transformed each spectrum again
+/// (~1.9 ms for the default scene's two 31 s models, on the window's thread). Recomputed
+/// only when the run has grown (or changed); the spectra also when they follow a moving
+/// cursor.
+#[derive(Debug, Default)]
+pub struct PlotCache {
+    key: Option<DataKey>,
+    /// The cursor the spectra were cut at (`None`: over everything computed).
+    spectra_until: Option<u64>,
+    data: std::sync::Arc<PlotData>,
+}
+
+impl PlotCache {
+    /// The same as [`PlotData::of`], from the kept data when nothing it depends on changed.
+    pub fn get(
+        &mut self,
+        timeline: &super::Timeline,
+        cursor: f64,
+        to_cursor: bool,
+    ) -> std::sync::Arc<PlotData> {
+        let key = DataKey::of(timeline);
+        let until = to_cursor.then_some(cursor.to_bits());
+        if self.key.as_ref() != Some(&key) {
+            self.data = std::sync::Arc::new(PlotData::of(timeline, cursor, to_cursor));
+        } else if self.spectra_until != until {
+            let data = std::sync::Arc::make_mut(&mut self.data);
+            data.add_spectra(timeline, cursor, to_cursor);
+        }
+        self.key = Some(key);
+        self.spectra_until = until;
+        std::sync::Arc::clone(&self.data)
     }
 }
 
@@ -405,7 +476,9 @@ fn value_at(points: &[[f64; 2]], x: f64) -> Option<f64> {
 /// Draws every plot section.
 pub fn plots_ui(state: &mut AppState, ui: &mut egui::Ui) {
     let t = state.play_time;
-    let data = PlotData::of(&state.timeline, t, state.view.spectrum_to_cursor);
+    let data = state
+        .plot_cache
+        .get(&state.timeline, t, state.view.spectrum_to_cursor);
     let cursor = Some((t, state.timeline.duration));
     let height = (ui.available_height() / 4.5).clamp(110.0, 220.0);
     let peak_m = |c: &Curve| format!("(peak {})", crate::post::format_number(c.peak));
