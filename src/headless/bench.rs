@@ -123,6 +123,11 @@ pub struct ExponentFit {
     /// Fitted exponent of the median time per step: the typical step, without the rare
     /// ones that factorise the matrix again (after a step cut or landed on an event).
     pub exponent_median: f64,
+    /// The slope of the median time per step between the family's two largest models:
+    /// the growth where the models are largest. The fit over all points is pulled down
+    /// by the small models' fixed costs per step, and can read linear while the large end
+    /// is not.
+    pub largest_pair_median: Option<f64>,
     /// Points in the fit.
     pub points: usize,
 }
@@ -252,6 +257,18 @@ pub fn fit_exponent(points: &[(f64, f64)]) -> Option<f64> {
     super::accuracy::observed_order(points, 0.0)
 }
 
+/// The log-log slope between the two points of largest x.
+fn largest_pair_slope(points: &[(f64, f64)]) -> Option<f64> {
+    let mut sorted = points.to_vec();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    match sorted.as_slice() {
+        [.., a, b] if a.0 > 0.0 && a.1 > 0.0 && b.0 > a.0 && b.1 > 0.0 => {
+            Some((b.1 / a.1).ln() / (b.0 / a.0).ln())
+        }
+        _ => None,
+    }
+}
+
 /// Runs the benchmark; `progress` is told what runs next.
 pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<BenchReport> {
     let repeats = if options.quick { 3 } else { options.repeats };
@@ -324,6 +341,7 @@ pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Benc
                 family: family.into(),
                 exponent,
                 exponent_median,
+                largest_pair_median: largest_pair_slope(&med),
                 points: mean.len(),
             });
         }
@@ -443,9 +461,12 @@ pub fn report_text(r: &BenchReport) -> String {
             );
         }
         for e in &r.exponents {
+            let large = e.largest_pair_median.map_or(String::new(), |x| {
+                format!("; ^{x:.2} between the two largest")
+            });
             let _ = writeln!(
                 s,
-                "time per step ∝ unknowns^{:.2} (mean), ^{:.2} (median) ({}, {} points)",
+                "time per step ∝ unknowns^{:.2} (mean), ^{:.2} (median) ({}, {} points{large})",
                 e.exponent, e.exponent_median, e.family, e.points
             );
         }
@@ -479,8 +500,11 @@ pub fn write_bench(r: &BenchReport, out: &Path) -> Result<Vec<PathBuf>> {
                 .iter()
                 .find(|e| e.family == *family)
                 .map_or(String::new(), |e| {
+                    let large = e
+                        .largest_pair_median
+                        .map_or(String::new(), |x| format!("; n^{x:.2} at the large end"));
                     format!(
-                        " (∝ n^{:.2} mean, n^{:.2} median)",
+                        " (∝ n^{:.2} mean, n^{:.2} median{large})",
                         e.exponent, e.exponent_median
                     )
                 });
@@ -533,6 +557,22 @@ mod tests {
         let e = fit_exponent(&pts).unwrap();
         assert!((e - 1.3).abs() < 1e-12);
         assert!(fit_exponent(&pts[..1]).is_none());
+    }
+
+    /// A fixed cost per step plus a superlinear part: the fit over all sizes reads near
+    /// linear, the two largest show the growth (the walls' case: 0.98 against ~1.3).
+    #[test]
+    fn the_largest_pair_shows_what_a_fixed_cost_hides() {
+        let pts: Vec<(f64, f64)> = [5000.0, 100.0, 1000.0, 10.0]
+            .iter()
+            .map(|&x: &f64| (x, 1.0 + 1e-4 * x.powf(1.5)))
+            .collect();
+        let all = fit_exponent(&pts).unwrap();
+        let large = largest_pair_slope(&pts).unwrap();
+        let exact = (1.0 + 1e-4 * 5000f64.powf(1.5)).ln() - (1.0 + 1e-4 * 1000f64.powf(1.5)).ln();
+        assert!((large - exact / 5f64.ln()).abs() < 1e-12);
+        assert!(all < 0.6 && large > 1.3, "fit {all}, largest pair {large}");
+        assert!(largest_pair_slope(&pts[..1]).is_none());
     }
 
     #[test]
