@@ -138,6 +138,7 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
                     cuts: d.counters().cuts,
                     elapsed_s,
                     remaining_s: estimate.observe(report.time, elapsed_s),
+                    harder_shaking_ahead: estimate.harder_shaking_ahead(report.time),
                 });
             }
         }

@@ -22,6 +22,10 @@ pub struct RunProgress {
     /// Wall-clock time still to go, s, as [`RemainingTime`] estimates it (`None` before
     /// any simulated time has passed).
     pub remaining_s: Option<f64>,
+    /// The ground has still to shake much harder than it has so far (see
+    /// [`RemainingTime::harder_shaking_ahead`]): the time left is then likely longer than
+    /// estimated, since nothing so far tells what the strong motion costs.
+    pub harder_shaking_ahead: bool,
 }
 
 impl RunProgress {
@@ -49,6 +53,9 @@ impl fmt::Display for RunProgress {
         )?;
         if let Some(left) = self.remaining_s {
             write!(f, ", about {left:.0} s to go")?;
+            if self.harder_shaking_ahead {
+                write!(f, " (likely more: the strongest shaking is still to come)")?;
+            }
         }
         Ok(())
     }
@@ -57,6 +64,11 @@ impl fmt::Display for RunProgress {
 /// Most points of the shaking's running integral kept (2¹⁶: 1 ms apart up to 65 s of
 /// run; a longer run spaces them wider).
 const MAX_INTENSITY_POINTS: usize = 1 << 16;
+
+/// How much harder, on average, the shaking still to come must be than the shaking so far
+/// for the time left to be flagged as likely longer (see
+/// [`RemainingTime::harder_shaking_ahead`]).
+pub const HARDER_AHEAD: f64 = 2.0;
 
 /// Spacing of the running integral's points, s (a record's own sampling is 5–20 ms).
 const INTENSITY_SPACING_S: f64 = 1e-3;
@@ -150,6 +162,20 @@ impl RemainingTime {
         Some(left.max(0.0))
     }
 
+    /// Whether the shaking still to come after simulated time `time_s` is, on average, at
+    /// least [`HARDER_AHEAD`] times as strong as the shaking so far (mean |a_g| over the
+    /// rest of the run against over `[0, t]`). Before the strong motion of a record the
+    /// fit has seen nothing of what it costs, and the time left it gives is then too short
+    /// (`wall:30` under Kobe: 0.39 of the truth at its first reports).
+    pub fn harder_shaking_ahead(&self, time_s: f64) -> bool {
+        let (t, end) = (time_s, self.duration_s);
+        if !(t > 0.0 && end.is_finite() && end > t) {
+            return false;
+        }
+        let (done, all) = (self.shaking_until(t), self.shaking_until(end));
+        (all - done) / (end - t) >= HARDER_AHEAD * done / t
+    }
+
     /// The least-squares `a, b ≥ 0`: the pair of the normal equations when both are
     /// non-negative, else the better of the fits by `t` alone and by `J` alone (with a
     /// single report, or no shaking yet, `t` and `J` cannot be told apart: the pace).
@@ -229,11 +255,23 @@ mod tests {
             cuts: 3,
             elapsed_s: 20.0,
             remaining_s: Some(60.0),
+            harder_shaking_ahead: false,
         };
         assert_eq!(p.fraction(), 0.25);
         let text = p.to_string();
         assert!(text.contains("t = 10.0 of 40.0 s (25 %)"), "{text}");
         assert!(text.contains("about 60 s to go"), "{text}");
+        assert!(!text.contains("likely more"), "{text}");
+        let early = RunProgress {
+            harder_shaking_ahead: true,
+            ..p
+        };
+        assert!(
+            early.to_string().ends_with(
+                "about 60 s to go (likely more: the strongest shaking is still to come)"
+            ),
+            "{early}"
+        );
         let start = RunProgress {
             remaining_s: None,
             ..p
@@ -282,7 +320,8 @@ mod tests {
         assert!((estimate.shaking_until(2.0) - 3.1).abs() < 0.03);
     }
 
-    /// Steady shaking: a cost proportional to the time is the pace so far.
+    /// Steady shaking: a cost proportional to the time is the pace so far, and no harder
+    /// shaking lies ahead.
     #[test]
     fn under_a_harmonic_the_estimate_is_the_pace() {
         let motion =
@@ -292,7 +331,22 @@ mod tests {
             let left = estimate.observe(t, 3.0 * t).unwrap();
             let pace = 3.0 * (40.0 - t);
             assert!((left - pace).abs() < 1e-9 * pace, "t {t}: {left} vs {pace}");
+            assert!(!estimate.harder_shaking_ahead(t), "t {t}");
         }
+    }
+
+    /// In the quiet second before the burst the shaking ahead is ~15 times the shaking so
+    /// far (mean |a_g| 1.55 against 0.1 m/s²): flagged. Late in the burst what is left is
+    /// milder than what was done: not flagged. At the start, and past the end, nothing is.
+    #[test]
+    fn harder_shaking_ahead_is_flagged_before_the_burst_only() {
+        let estimate = RemainingTime::new(&burst(), 3.0);
+        assert!(estimate.harder_shaking_ahead(0.5));
+        assert!(estimate.harder_shaking_ahead(0.99));
+        assert!(!estimate.harder_shaking_ahead(1.9));
+        assert!(!estimate.harder_shaking_ahead(2.5));
+        assert!(!estimate.harder_shaking_ahead(0.0));
+        assert!(!estimate.harder_shaking_ahead(3.0));
     }
 
     /// Before any shaking J is zero: the time alone fits, and a first report is the pace.
