@@ -257,16 +257,12 @@ pub fn fit_exponent(points: &[(f64, f64)]) -> Option<f64> {
     super::accuracy::observed_order(points, 0.0)
 }
 
-/// The log-log slope between the two points of largest x.
+/// The log-log slope between the two points of largest x (the same fit as
+/// [`fit_exponent`], on those two).
 fn largest_pair_slope(points: &[(f64, f64)]) -> Option<f64> {
     let mut sorted = points.to_vec();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-    match sorted.as_slice() {
-        [.., a, b] if a.0 > 0.0 && a.1 > 0.0 && b.0 > a.0 && b.1 > 0.0 => {
-            Some((b.1 / a.1).ln() / (b.0 / a.0).ln())
-        }
-        _ => None,
-    }
+    fit_exponent(&sorted[sorted.len().saturating_sub(2)..])
 }
 
 /// Runs the benchmark; `progress` is told what runs next.
