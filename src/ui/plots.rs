@@ -256,7 +256,6 @@ impl PlotData {
         let Some(main) = timeline.samples.first() else {
             return;
         };
-        let d = self;
         let until = if to_cursor { cursor } else { f64::INFINITY };
         let mut add_spectrum =
             |name: String, s: &Samples, col: fn(&Samples) -> &Vec<f64>, color| {
@@ -273,8 +272,8 @@ impl PlotData {
                     // The ground's spectrum is the fixed base's (a bonded base moves with
                     // the ground): dashed and drawn on top, it stays visible.
                     c.dashed = color.is_none();
-                    d.spectrum.push(c);
-                    d.spectrum_peaks.push(peak);
+                    self.spectrum.push(c);
+                    self.spectrum_peaks.push(peak);
                 }
             };
         add_spectrum("ground".into(), main, |s| &s.ground_accel, None);
