@@ -21,13 +21,22 @@ use crate::model::geometry::{self, Point};
 pub struct DofMap {
     /// For each block, the index of its first unknown, or `None` when prescribed.
     pub slot: Vec<Option<usize>>,
+    /// For each block, how many of its six unknowns the matrix needs: 3 for a rigid block,
+    /// whose strain rows and columns are held (see [`System::hold_strains`], which
+    /// overwrites whatever was added there), else 6.
+    pub moving: Vec<usize>,
     /// Number of unknowns.
     pub n: usize,
 }
 
 impl DofMap {
-    /// Numbers the free blocks in order.
+    /// Numbers the free blocks in order (all of them deformable).
     pub fn new(is_free: &[bool]) -> Self {
+        Self::with_rigid(is_free, &vec![false; is_free.len()])
+    }
+
+    /// Numbers the free blocks in order; `rigid` marks the blocks whose strains are held.
+    pub fn with_rigid(is_free: &[bool], rigid: &[bool]) -> Self {
         let mut n = 0;
         let slot = is_free
             .iter()
@@ -40,7 +49,8 @@ impl DofMap {
                 }
             })
             .collect();
-        Self { slot, n }
+        let moving = rigid.iter().map(|&r| if r { 3 } else { 6 }).collect();
+        Self { slot, moving, n }
     }
 }
 
@@ -161,7 +171,8 @@ impl System {
             let Some(sp) = dofs.slot[bp] else { continue };
             for &(bq, vq) in parts.iter().flatten() {
                 if let Some(sq) = dofs.slot[bq] {
-                    self.k.add_outer(sp / 6, sq / 6, vp, vq, c);
+                    let leading = (dofs.moving[bp], dofs.moving[bq]);
+                    self.k.add_outer_leading(sp / 6, sq / 6, vp, vq, c, leading);
                 }
             }
         }
@@ -225,22 +236,21 @@ impl System {
                 if dofs.slot[bq].is_some_and(|sq| sq < sp) {
                     continue;
                 }
-                // m = Σ over the nodes k on block p of T_kᵀ s[k][q] (6×6), column by column
-                // (formed as the rows of its transpose: each column is six adjacent sums).
-                let mut m_t = [[0.0; 6]; 6];
-                for &k in by_block.members(gp) {
-                    let skq = &s[k][gq];
-                    for (j, m_tj) in m_t.iter_mut().enumerate() {
-                        let column = t_transpose_at(offsets[k], [skq[0][j], skq[1][j]]);
-                        for (m_ij, c_i) in m_tj.iter_mut().zip(column) {
-                            *m_ij += c_i;
-                        }
-                    }
-                }
-                let m = transpose(&m_t);
+                let members = by_block.members(gp);
                 match dofs.slot[bq] {
-                    Some(sq) => self.k.add(sp / 6, sq / 6, &m, c),
+                    Some(sq) => {
+                        // A rigid block's strain rows and columns are held: only the
+                        // leading part is formed (the rest stays zero and is overwritten).
+                        let m = match (dofs.moving[blocks[gp]], dofs.moving[bq]) {
+                            (3, 3) => pair_block::<3, 3>(members, &offsets, &s, gq),
+                            (3, _) => pair_block::<3, 6>(members, &offsets, &s, gq),
+                            (_, 3) => pair_block::<6, 3>(members, &offsets, &s, gq),
+                            _ => pair_block::<6, 6>(members, &offsets, &s, gq),
+                        };
+                        self.k.add(sp / 6, sq / 6, &m, c);
+                    }
                     None => {
+                        let m = pair_block::<6, 6>(members, &offsets, &s, gq);
                         for i in 0..6 {
                             let s: f64 = (0..6).map(|j| m[i][j] * known[bq][j]).sum();
                             self.r[sp + i] -= c * s;
@@ -250,6 +260,28 @@ impl System {
             }
         }
     }
+}
+
+/// Block (p, q) of a nodal element, `m = Σ T_kᵀ s[k][q]` over the nodes k on block p (see
+/// [`System::add_nodal_element`]), its leading `R` rows and `C` columns (the rest zero).
+/// Formed column by column as the rows of its transpose (each column is adjacent sums).
+fn pair_block<const R: usize, const C: usize>(
+    members: &[usize],
+    offsets: &[Point; MAX_NODES],
+    s: &[[[[f64; 6]; 2]; MAX_NODES]; MAX_NODES],
+    gq: usize,
+) -> Mat6 {
+    let mut m_t = [[0.0; 6]; 6];
+    for &k in members {
+        let skq = &s[k][gq];
+        for (j, m_tj) in m_t.iter_mut().enumerate().take(C) {
+            let column = t_transpose_at(offsets[k], [skq[0][j], skq[1][j]]);
+            for (m_ij, c_i) in m_tj.iter_mut().zip(column).take(R) {
+                *m_ij += c_i;
+            }
+        }
+    }
+    transpose(&m_t)
 }
 
 /// An element's nodes grouped by the block that carries them (first appearance order).

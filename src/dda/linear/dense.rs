@@ -48,8 +48,11 @@ impl<const N: usize> DenseCholesky<N> {
         self.columns[column][row] = value;
     }
 
-    /// Factorises the matrix written since [`DenseCholesky::clear`], in place. False
-    /// (and no factor held) if it is not positive definite.
+    /// Factorises the matrix written since [`DenseCholesky::clear`], in place, holding
+    /// the unknowns whose rows and columns are the identity's (found by looking). False
+    /// (and no factor held) if it is not positive definite. The solver knows which it
+    /// holds and calls [`DenseCholesky::factorize_holding`]; this is the tests' reference.
+    #[cfg(test)]
     pub(crate) fn factorize(&mut self) -> bool {
         self.held = self.identity_rows();
         self.ready = self.factorize_in_place();

@@ -139,16 +139,21 @@ pub struct BlockMatrix {
     /// A coupling outside the pattern was added (a bug in the model setup): the solve
     /// refuses rather than silently dropping it.
     outside_pattern: bool,
+    /// Per block, whether its strain unknowns are held ([`BlockMatrix::hold_strains`]):
+    /// a small factor then neither copies nor looks for their identity rows.
+    held_strains: Vec<bool>,
 }
 
 impl BlockMatrix {
     /// The zero matrix on a pattern.
     pub fn zeros(pattern: Arc<BlockPattern>) -> Self {
         let blocks = vec![[[0.0; 6]; 6]; pattern.entries.len()];
+        let held_strains = vec![false; pattern.blocks];
         Self {
             pattern,
             blocks,
             outside_pattern: false,
+            held_strains,
         }
     }
 
@@ -166,12 +171,14 @@ impl BlockMatrix {
     pub fn clear(&mut self) {
         self.blocks.iter_mut().for_each(|b| *b = [[0.0; 6]; 6]);
         self.outside_pattern = false;
+        self.held_strains.fill(false);
     }
 
     /// Copies the values of `other` (same pattern) without allocating.
     pub fn copy_from(&mut self, other: &BlockMatrix) {
         self.blocks.copy_from_slice(&other.blocks);
         self.outside_pattern = other.outside_pattern;
+        self.held_strains.copy_from_slice(&other.held_strains);
     }
 
     /// Adds `scale · m` to block (bi, bj) (block indices in unknown order). Only blocks
@@ -191,15 +198,46 @@ impl BlockMatrix {
     /// Adds `scale · u vᵀ` to block (bi, bj) (same storage rule as [`BlockMatrix::add`]).
     #[inline]
     pub fn add_outer(&mut self, bi: usize, bj: usize, u: &[f64; 6], v: &[f64; 6], scale: f64) {
-        if let Some(b) = self.upper_block(bi, bj) {
-            for r in 0..6 {
+        self.add_outer_leading(bi, bj, u, v, scale, (6, 6));
+    }
+
+    /// [`BlockMatrix::add_outer`] on the leading `rows × cols` of the block only (3 or 6
+    /// each): a rigid block's strain rows and columns are held afterwards
+    /// ([`BlockMatrix::hold_strains`]), so what would be added there is never read. The
+    /// entries it does add are the same sums in the same order.
+    #[inline]
+    pub fn add_outer_leading(
+        &mut self,
+        bi: usize,
+        bj: usize,
+        u: &[f64; 6],
+        v: &[f64; 6],
+        scale: f64,
+        (rows, cols): (usize, usize),
+    ) {
+        // Sizes fixed at compile time: the deformable blocks' 6 × 6 loop stays unrolled.
+        fn add<const R: usize, const C: usize>(
+            b: &mut Mat6,
+            u: &[f64; 6],
+            v: &[f64; 6],
+            scale: f64,
+        ) {
+            for r in 0..R {
                 let s = scale * u[r];
                 if s == 0.0 {
                     continue;
                 }
-                for c in 0..6 {
+                for c in 0..C {
                     b[r][c] += s * v[c];
                 }
+            }
+        }
+        if let Some(b) = self.upper_block(bi, bj) {
+            match (rows, cols) {
+                (3, 3) => add::<3, 3>(b, u, v, scale),
+                (3, _) => add::<3, 6>(b, u, v, scale),
+                (_, 3) => add::<6, 3>(b, u, v, scale),
+                _ => add::<6, 6>(b, u, v, scale),
             }
         }
     }
@@ -225,6 +263,7 @@ impl BlockMatrix {
     /// solve to zero exactly — the restriction of the system to a rigid block's three
     /// rigid-body unknowns, without a stiff (and ringing) mode in their place.
     pub fn hold_strains(&mut self, bi: usize) {
+        self.held_strains[bi] = true;
         for (e, &(i, j)) in self.pattern.entries.iter().enumerate() {
             let b = &mut self.blocks[e];
             if i == bi {
@@ -339,12 +378,13 @@ impl BlockMatrix {
     }
 
     /// Calls `set(row, col, value)` for every stored value of the lower triangle (row ≥
-    /// col); the entries not visited are zero.
+    /// col) but those in the rows and columns of held strains (the identity's by
+    /// construction); the entries not visited are zero or held.
     fn for_each_lower(&self, mut set: impl FnMut(usize, usize, f64)) {
+        let moving = |b: usize| if self.held_strains[b] { 3 } else { 6 };
         for (e, &(i, j)) in self.pattern.entries.iter().enumerate() {
-            for r in 0..6 {
-                for c in 0..6 {
-                    // Block (i, j) holds K[6i + r][6j + c]; its transpose is the lower part.
+            for r in 0..moving(i) {
+                for c in 0..moving(j) {
                     let (row, col) = (6 * j + c, 6 * i + r);
                     if row >= col {
                         set(row, col, self.blocks[e][r][c]);
@@ -352,6 +392,12 @@ impl BlockMatrix {
                 }
             }
         }
+    }
+
+    /// Which unknowns are held (the strains of the blocks held by
+    /// [`BlockMatrix::hold_strains`]), for a system of `N` unknowns.
+    fn held_unknowns<const N: usize>(&self) -> [bool; N] {
+        std::array::from_fn(|u| u % 6 >= 3 && self.held_strains[u / 6])
     }
 
     /// Writes the stored values in compressed-column order, value `p` at `values[at[p]]`
@@ -474,10 +520,16 @@ impl Tiny {
     }
 
     fn factorize(&mut self, k: &BlockMatrix) -> Result<(), SolveError> {
+        // The held unknowns are known from the matrix (a rigid block's strains): only the
+        // rest is copied, and the held rows are written as the identity's they are.
         fn factor<const N: usize>(c: &mut DenseCholesky<N>, k: &BlockMatrix) -> bool {
             c.clear();
             k.for_each_lower(|row, column, value| c.set(row, column, value));
-            c.factorize()
+            let held = k.held_unknowns::<N>();
+            for (u, _) in held.iter().enumerate().filter(|(_, h)| **h) {
+                c.set(u, u, 1.0);
+            }
+            c.factorize_holding(held)
         }
         let factored = match self {
             Tiny::B1(c) => factor(c, k),
@@ -1237,5 +1289,89 @@ pub(super) mod tests {
             solver.solve(&k, &[1.0; 12], 0, &mut x),
             Err(SolveError::OutsidePattern)
         );
+    }
+
+    /// A rigid block's strain rows and columns are held after assembly, so its springs
+    /// need only their leading part added, and the small factor need not copy the held
+    /// rows nor look for them: the held matrix is the same to the bit as with everything
+    /// added, and the solution the same to the bit as the factor that finds the identity
+    /// rows by looking (`DenseCholesky::factorize`), with the held unknowns exactly zero.
+    #[test]
+    fn held_strains_need_not_be_assembled_or_copied() {
+        // Block 0 rigid, block 1 deformable; a mass on each and random springs between.
+        let pattern = Arc::new(BlockPattern::new(2, [(0, 1)]));
+        let mut next = pseudo_random(11);
+        let mut everything = BlockMatrix::zeros(Arc::clone(&pattern));
+        let mut leading = BlockMatrix::zeros(Arc::clone(&pattern));
+        for b in 0..2 {
+            let mut m = [[0.0; 6]; 6];
+            for (r, row) in m.iter_mut().enumerate() {
+                row[r] = 10.0 + next();
+            }
+            everything.add(b, b, &m, 1.0);
+            leading.add(b, b, &m, 1.0);
+        }
+        let moving = [3, 6];
+        for _ in 0..4 {
+            let u: [f64; 6] = std::array::from_fn(|_| next());
+            let v: [f64; 6] = std::array::from_fn(|_| next());
+            for (i, a, j, b) in [
+                (0, &u, 0, &u),
+                (0, &u, 1, &v),
+                (1, &v, 0, &u),
+                (1, &v, 1, &v),
+            ] {
+                everything.add_outer(i, j, a, b, 100.0);
+                leading.add_outer_leading(i, j, a, b, 100.0, (moving[i], moving[j]));
+            }
+        }
+        assert!(
+            everything.blocks != leading.blocks,
+            "the leading adds skip something"
+        );
+        everything.hold_strains(0);
+        leading.hold_strains(0);
+        let bits = |k: &BlockMatrix| -> Vec<u64> {
+            k.blocks
+                .iter()
+                .flatten()
+                .flatten()
+                .map(|v| v.to_bits())
+                .collect()
+        };
+        assert_eq!(bits(&everything), bits(&leading));
+
+        let rhs: Vec<f64> = (0..12)
+            .map(|i| {
+                if (3..6).contains(&i) {
+                    0.0
+                } else {
+                    (i as f64 * 0.37).sin()
+                }
+            })
+            .collect();
+        let mut solver = LinearSolver::new(Arc::clone(&pattern)).unwrap();
+        let mut x = vec![0.0; 12];
+        solver.solve(&leading, &rhs, 0, &mut x).unwrap();
+        // Every value copied (the held rows too, no flags), then found by looking.
+        let mut looking = DenseCholesky::<12>::empty();
+        looking.clear();
+        let mut unflagged = everything.clone();
+        unflagged.held_strains.fill(false);
+        unflagged.for_each_lower(|row, column, value| looking.set(row, column, value));
+        assert!(looking.factorize());
+        let mut expected = rhs.clone();
+        looking.solve(&mut expected);
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0);
+        for i in 0..12 {
+            assert!(
+                same(x[i], expected[i]),
+                "unknown {i}: {} vs {}",
+                x[i],
+                expected[i]
+            );
+        }
+        assert!(x[3..6].iter().all(|&v| v == 0.0));
+        assert_solves(&everything, &rhs, &x);
     }
 }

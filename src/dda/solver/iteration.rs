@@ -508,16 +508,14 @@ impl Dda {
 
     /// Increments of all blocks from the solution vector and the known ones.
     pub(super) fn increments(&self, solution: &[f64], known: &[Vec6]) -> PerBlock<Vec6> {
-        (0..self.blocks.len())
-            .map(|b| match self.dofs.slot[b] {
-                Some(s) => {
-                    let mut d = [0.0; 6];
-                    d.copy_from_slice(&solution[s..s + 6]);
-                    d
-                }
-                None => known[b],
-            })
-            .collect()
+        per_block(self.blocks.len(), |b| match self.dofs.slot[b] {
+            Some(s) => {
+                let mut d = [0.0; 6];
+                d.copy_from_slice(&solution[s..s + 6]);
+                d
+            }
+            None => known[b],
+        })
     }
 }
 

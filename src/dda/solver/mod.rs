@@ -43,6 +43,19 @@ use crate::{Error, Result};
 /// handful of small vectors per step was 4 % of it. Larger models spill to the heap.
 type PerBlock<T> = SmallVec<[T; 4]>;
 
+/// The per-block vector of `value(b)` for `n` blocks. Up to four are written straight
+/// into the inline buffer: `collect` pushes one at a time, testing the capacity and where
+/// the values are stored at each push, which cost more than the values of a two-block
+/// step's vectors themselves.
+fn per_block<T: Copy + Default>(n: usize, mut value: impl FnMut(usize) -> T) -> PerBlock<T> {
+    if n <= 4 {
+        let values: [T; 4] = std::array::from_fn(|b| if b < n { value(b) } else { T::default() });
+        SmallVec::from_buf_and_len(values, n)
+    } else {
+        (0..n).map(value).collect()
+    }
+}
+
 /// State changes of one contact within one step after which its state is kept.
 const MAX_FLIPS_PER_STEP: u32 = 4;
 
@@ -444,7 +457,8 @@ impl Dda {
             .iter()
             .map(|b| b.role != BlockRole::PrescribedGround)
             .collect();
-        let dofs = DofMap::new(&is_free);
+        let rigid: Vec<bool> = blocks.iter().map(|b| b.rigid).collect();
+        let dofs = DofMap::with_rigid(&is_free, &rigid);
         let pattern = Arc::new(coupling_pattern(
             &dofs,
             &pairs,
@@ -895,7 +909,7 @@ impl Dda {
     /// The blocks' centroids at the step start, the origins of their unknowns (a copy,
     /// so that the blocks can be moved while it is read).
     fn centroids(&self) -> PerBlock<Point> {
-        self.blocks.iter().map(|b| b.moments.centroid).collect()
+        per_block(self.blocks.len(), |b| self.blocks[b].moments.centroid)
     }
 
     /// Known increments of the blocks without unknowns: none move, since the model moves

@@ -599,11 +599,9 @@ impl Dda {
     ) -> Result<StepReport> {
         let c = self.coeffs;
         let t_new = self.time + dt;
-        let start: PerBlock<[Vec6; 2]> = self
-            .blocks
-            .iter()
-            .map(|b| [b.velocity, b.response_accel])
-            .collect();
+        let start: PerBlock<[Vec6; 2]> = per_block(self.blocks.len(), |b| {
+            [self.blocks[b].velocity, self.blocks[b].response_accel]
+        });
         // Newmark update of velocities and accelerations.
         for (b, d) in self.blocks.iter_mut().zip(increments) {
             if b.role == BlockRole::PrescribedGround {
@@ -732,17 +730,14 @@ impl Dda {
         // The forces this step balanced at its end, to be compared with those of the
         // geometry it moves to (see `rebalance_accelerations`).
         let before = self.configuration_forces(Some(increments));
-        let old_inertia: PerBlock<Vec6> = self
-            .blocks
-            .iter()
-            .map(|b| {
-                let mut f = [0.0; 6];
-                for i in 0..6 {
-                    f[i] = (0..6).map(|j| b.mass[i][j] * b.response_accel[j]).sum();
-                }
-                f
-            })
-            .collect();
+        let old_inertia: PerBlock<Vec6> = per_block(self.blocks.len(), |bi| {
+            let b = &self.blocks[bi];
+            let mut f = [0.0; 6];
+            for i in 0..6 {
+                f[i] = (0..6).map(|j| b.mass[i][j] * b.response_accel[j]).sum();
+            }
+            f
+        });
         self.commit_geometry(increments)?;
         // The contacts' forces at the step's end (in the memory just written) along the
         // step's gradients.
