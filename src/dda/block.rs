@@ -74,7 +74,7 @@ pub fn point_displacement(c: Point, p: Point, d: &Vec6) -> Point {
 /// contacts book it the same way (the constraint work in `Dda::commit_step`).
 ///
 /// The classic update is the paper's linear map `T·D`: R = I + r0·J and S = ΔE.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepMap {
     /// Sine of the rotation (r0 itself for the linear map).
     pub sin: f64,

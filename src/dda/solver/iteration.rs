@@ -489,10 +489,9 @@ impl Dda {
     /// from the motion), used to judge slip reversals.
     pub(super) fn end_velocities(&self, increments: &[Vec6], dt: f64) -> PerBlock<Vec6> {
         let c = &self.coeffs;
-        self.blocks
-            .iter()
-            .zip(increments)
-            .map(|(b, d)| match b.role {
+        per_block(self.blocks.len(), |bi| {
+            let (b, d) = (&self.blocks[bi], &increments[bi]);
+            match b.role {
                 BlockRole::PrescribedGround => [0.0; 6],
                 _ => {
                     let mut v = [0.0; 6];
@@ -502,8 +501,8 @@ impl Dda {
                     }
                     v
                 }
-            })
-            .collect()
+            }
+        })
     }
 
     /// Increments of all blocks from the solution vector and the known ones.

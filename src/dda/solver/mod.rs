@@ -916,7 +916,7 @@ impl Dda {
     /// with the ground (see [`Dda::frame_displacement`]): a prescribed ground stands still
     /// in it, and the ground's acceleration acts on every block as a body force instead.
     fn known_increments(&self) -> PerBlock<Vec6> {
-        PerBlock::from_elem([0.0; 6], self.blocks.len())
+        per_block(self.blocks.len(), |_| [0.0; 6])
     }
 
     /// Sets the velocity of block `b`'s six unknowns (an initial condition: call before

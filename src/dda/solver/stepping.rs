@@ -38,10 +38,9 @@ impl Dda {
     pub(super) fn commit_geometry(&mut self, increments: &[Vec6]) -> Result<()> {
         self.forget_next_step_detection();
         let centroids = self.centroids();
-        let maps: PerBlock<StepMap> = increments
-            .iter()
-            .map(|d| StepMap::new(d, self.params.exact_rotation))
-            .collect();
+        let exact = self.params.exact_rotation;
+        let maps: PerBlock<StepMap> =
+            per_block(increments.len(), |b| StepMap::new(&increments[b], exact));
         let motion = StepMotion {
             centroids: &centroids,
             increments,
@@ -468,7 +467,7 @@ impl Dda {
                 .collect(),
             memory: self.memory.clone(),
         };
-        let mut released: PerBlock<Vec6> = PerBlock::from_elem([0.0; 6], self.blocks.len());
+        let mut released: PerBlock<Vec6> = per_block(self.blocks.len(), |_| [0.0; 6]);
         for c in &self.contacts {
             if !c.opens_under_load() {
                 continue;
@@ -811,7 +810,7 @@ impl Dda {
     /// without, their values at the current geometry, contacts included (the forces the
     /// next step starts from).
     pub(super) fn configuration_forces(&mut self, increments: Option<&[Vec6]>) -> PerBlock<Vec6> {
-        let mut out: PerBlock<Vec6> = PerBlock::from_elem([0.0; 6], self.blocks.len());
+        let mut out: PerBlock<Vec6> = per_block(self.blocks.len(), |_| [0.0; 6]);
         let centroids = self.centroids();
         let zero = [0.0; 6];
         let inc = |b: usize| increments.map_or(&zero, |d| &d[b]);
