@@ -95,6 +95,12 @@ impl System {
         self.k.add(s / 6, s / 6, m, scale);
     }
 
+    /// [`System::add_diag_block`] on the leading `moving × moving` part only (see
+    /// [`DofMap::moving`]): for a system whose rigid blocks' strains will be held.
+    pub fn add_diag_block_leading(&mut self, s: usize, m: &Mat6, scale: f64, moving: usize) {
+        self.k.add_leading(s / 6, s / 6, m, scale, (moving, moving));
+    }
+
     /// Holds the strain unknowns of the block whose unknowns start at `s` at zero (a
     /// rigid block, see [`BlockMatrix::hold_strains`]).
     pub fn hold_strains(&mut self, s: usize) {
@@ -247,7 +253,8 @@ impl System {
                             (_, 3) => pair_block::<6, 3>(members, &offsets, &s, gq),
                             _ => pair_block::<6, 6>(members, &offsets, &s, gq),
                         };
-                        self.k.add(sp / 6, sq / 6, &m, c);
+                        let leading = (dofs.moving[blocks[gp]], dofs.moving[bq]);
+                        self.k.add_leading(sp / 6, sq / 6, &m, c, leading);
                     }
                     None => {
                         let m = pair_block::<6, 6>(members, &offsets, &s, gq);

@@ -372,7 +372,12 @@ impl Block {
 
     /// Kinetic energy `½ vᵀ M v`, J per unit thickness.
     pub fn kinetic_energy(&self) -> f64 {
-        0.5 * super::mat6::quadratic_form(&self.mass, &self.velocity, &self.velocity)
+        let form = if self.rigid {
+            super::mat6::quadratic_form_rigid
+        } else {
+            super::mat6::quadratic_form
+        };
+        0.5 * form(&self.mass, &self.velocity, &self.velocity)
     }
 
     /// A free block of unit density and stiffness (the geometry tests' block).

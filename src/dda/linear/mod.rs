@@ -186,11 +186,33 @@ impl BlockMatrix {
     /// term, and the lower one is the transpose of the upper.
     #[inline]
     pub fn add(&mut self, bi: usize, bj: usize, m: &Mat6, scale: f64) {
-        if let Some(b) = self.upper_block(bi, bj) {
-            for r in 0..6 {
-                for c in 0..6 {
+        self.add_leading(bi, bj, m, scale, (6, 6));
+    }
+
+    /// [`BlockMatrix::add`] on the leading `rows × cols` of the block only (3 or 6 each),
+    /// for the same reason as [`BlockMatrix::add_outer_leading`].
+    #[inline]
+    pub fn add_leading(
+        &mut self,
+        bi: usize,
+        bj: usize,
+        m: &Mat6,
+        scale: f64,
+        (rows, cols): (usize, usize),
+    ) {
+        fn add<const R: usize, const C: usize>(b: &mut Mat6, m: &Mat6, scale: f64) {
+            for r in 0..R {
+                for c in 0..C {
                     b[r][c] += scale * m[r][c];
                 }
+            }
+        }
+        if let Some(b) = self.upper_block(bi, bj) {
+            match (rows, cols) {
+                (3, 3) => add::<3, 3>(b, m, scale),
+                (3, _) => add::<3, 6>(b, m, scale),
+                (_, 3) => add::<6, 3>(b, m, scale),
+                _ => add::<6, 6>(b, m, scale),
             }
         }
     }
@@ -1298,20 +1320,24 @@ pub(super) mod tests {
     /// rows by looking (`DenseCholesky::factorize`), with the held unknowns exactly zero.
     #[test]
     fn held_strains_need_not_be_assembled_or_copied() {
-        // Block 0 rigid, block 1 deformable; a mass on each and random springs between.
+        // Block 0 rigid, block 1 deformable; a mass on each, a full coupling block and
+        // random springs between.
         let pattern = Arc::new(BlockPattern::new(2, [(0, 1)]));
         let mut next = pseudo_random(11);
         let mut everything = BlockMatrix::zeros(Arc::clone(&pattern));
         let mut leading = BlockMatrix::zeros(Arc::clone(&pattern));
+        let moving = [3, 6];
         for b in 0..2 {
             let mut m = [[0.0; 6]; 6];
             for (r, row) in m.iter_mut().enumerate() {
                 row[r] = 10.0 + next();
             }
             everything.add(b, b, &m, 1.0);
-            leading.add(b, b, &m, 1.0);
+            leading.add_leading(b, b, &m, 1.0, (moving[b], moving[b]));
         }
-        let moving = [3, 6];
+        let coupling: Mat6 = std::array::from_fn(|_| std::array::from_fn(|_| 0.1 * next()));
+        everything.add(0, 1, &coupling, 1.0);
+        leading.add_leading(0, 1, &coupling, 1.0, (moving[0], moving[1]));
         for _ in 0..4 {
             let u: [f64; 6] = std::array::from_fn(|_| next());
             let v: [f64; 6] = std::array::from_fn(|_| next());

@@ -69,13 +69,18 @@ impl Dda {
             let Some(s) = self.dofs.slot[bi] else {
                 continue;
             };
-            sys.add_diag_block(s, &b.mass, mass_factor);
+            // A rigid block's strain rows and columns are held after assembly (see
+            // `DofMap::moving`): its mass there and its elastic stiffness are not added.
+            let moving = self.dofs.moving[bi];
+            sys.add_diag_block_leading(s, &b.mass, mass_factor, moving);
             // Elastic stiffness on the strain unknowns and the initial-stress force.
-            let diagonal = sys.k.diagonal_mut(s / 6);
-            for i in 0..3 {
-                for j in 0..3 {
-                    diagonal[3 + i][3 + j] +=
-                        stiffness_factor * b.moments.area * b.elasticity[i][j];
+            if moving == 6 {
+                let diagonal = sys.k.diagonal_mut(s / 6);
+                for i in 0..3 {
+                    for j in 0..3 {
+                        diagonal[3 + i][3 + j] +=
+                            stiffness_factor * b.moments.area * b.elasticity[i][j];
+                    }
                 }
             }
             for i in 0..3 {
