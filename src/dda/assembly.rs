@@ -21,8 +21,9 @@ use crate::model::geometry::{self, Point};
 pub struct DofMap {
     /// For each block, the index of its first unknown, or `None` when prescribed.
     pub slot: Vec<Option<usize>>,
-    /// For each block, how many of its six unknowns the matrix needs: 3 for a rigid block,
-    /// whose strain rows and columns are held (see [`System::hold_strains`], which
+    /// For each block, how many of its six unknowns the matrix needs
+    /// ([`Block::moving_unknowns`](super::block::Block::moving_unknowns)): 3 for a rigid
+    /// block, whose strain rows and columns are held (see [`System::hold_strains`], which
     /// overwrites whatever was added there), else 6.
     pub moving: Vec<usize>,
     /// Number of unknowns.
@@ -30,13 +31,9 @@ pub struct DofMap {
 }
 
 impl DofMap {
-    /// Numbers the free blocks in order (all of them deformable).
-    pub fn new(is_free: &[bool]) -> Self {
-        Self::with_rigid(is_free, &vec![false; is_free.len()])
-    }
-
-    /// Numbers the free blocks in order; `rigid` marks the blocks whose strains are held.
-    pub fn with_rigid(is_free: &[bool], rigid: &[bool]) -> Self {
+    /// Numbers the free blocks in order; `moving` is each block's count of unknowns that
+    /// move (see [`DofMap::moving`]).
+    pub fn new(is_free: &[bool], moving: Vec<usize>) -> Self {
         let mut n = 0;
         let slot = is_free
             .iter()
@@ -49,7 +46,6 @@ impl DofMap {
                 }
             })
             .collect();
-        let moving = rigid.iter().map(|&r| if r { 3 } else { 6 }).collect();
         Self { slot, moving, n }
     }
 }
@@ -247,13 +243,13 @@ impl System {
                     Some(sq) => {
                         // A rigid block's strain rows and columns are held: only the
                         // leading part is formed (the rest stays zero and is overwritten).
-                        let m = match (dofs.moving[blocks[gp]], dofs.moving[bq]) {
+                        let leading = (dofs.moving[blocks[gp]], dofs.moving[bq]);
+                        let m = match leading {
                             (3, 3) => pair_block::<3, 3>(members, &offsets, &s, gq),
                             (3, _) => pair_block::<3, 6>(members, &offsets, &s, gq),
                             (_, 3) => pair_block::<6, 3>(members, &offsets, &s, gq),
                             _ => pair_block::<6, 6>(members, &offsets, &s, gq),
                         };
-                        let leading = (dofs.moving[blocks[gp]], dofs.moving[bq]);
                         self.k.add_leading(sp / 6, sq / 6, &m, c, leading);
                     }
                     None => {

@@ -372,12 +372,17 @@ impl Block {
 
     /// Kinetic energy `½ vᵀ M v`, J per unit thickness.
     pub fn kinetic_energy(&self) -> f64 {
-        let form = if self.rigid {
-            super::mat6::quadratic_form_rigid
+        0.5 * self.mass_form(&self.velocity, &self.velocity)
+    }
+
+    /// `xᵀ M y` with the block's mass matrix, for vectors of its unknowns (a rigid
+    /// block's strain entries are held at zero, and their terms are left out).
+    pub fn mass_form(&self, x: &Vec6, y: &Vec6) -> f64 {
+        if self.rigid {
+            super::mat6::quadratic_form_rigid(&self.mass, x, y)
         } else {
-            super::mat6::quadratic_form
-        };
-        0.5 * form(&self.mass, &self.velocity, &self.velocity)
+            super::mat6::quadratic_form(&self.mass, x, y)
+        }
     }
 
     /// A free block of unit density and stiffness (the geometry tests' block).

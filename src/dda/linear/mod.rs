@@ -407,6 +407,7 @@ impl BlockMatrix {
         for (e, &(i, j)) in self.pattern.entries.iter().enumerate() {
             for r in 0..moving(i) {
                 for c in 0..moving(j) {
+                    // Block (i, j) holds K[6i + r][6j + c]; its transpose is the lower part.
                     let (row, col) = (6 * j + c, 6 * i + r);
                     if row >= col {
                         set(row, col, self.blocks[e][r][c]);

@@ -457,8 +457,10 @@ impl Dda {
             .iter()
             .map(|b| b.role != BlockRole::PrescribedGround)
             .collect();
-        let rigid: Vec<bool> = blocks.iter().map(|b| b.rigid).collect();
-        let dofs = DofMap::with_rigid(&is_free, &rigid);
+        let dofs = DofMap::new(
+            &is_free,
+            blocks.iter().map(Block::moving_unknowns).collect(),
+        );
         let pattern = Arc::new(coupling_pattern(
             &dofs,
             &pairs,

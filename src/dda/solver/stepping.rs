@@ -3,7 +3,6 @@
 use super::iteration::yield_stretch;
 use super::*;
 use crate::dda::linear::DenseCholesky;
-use crate::dda::mat6::{quadratic_form, quadratic_form_rigid};
 
 impl Dda {
     /// Largest vertex displacement of the structure relative to the ground translation,
@@ -631,14 +630,8 @@ impl Dda {
             for k in 0..6 {
                 a_mean[k] = 0.5 * (a0[k] + b.response_accel[k]);
             }
-            // A rigid block's strain rates and increments are held at zero.
-            let form = if b.rigid {
-                quadratic_form_rigid
-            } else {
-                quadratic_form
-            };
-            numerical += form(&b.mass, &a_mean, d) - 0.5 * form(&b.mass, &b.velocity, &b.velocity)
-                + 0.5 * form(&b.mass, v0, v0);
+            numerical += b.mass_form(&a_mean, d) - 0.5 * b.mass_form(&b.velocity, &b.velocity)
+                + 0.5 * b.mass_form(v0, v0);
         }
         // Friction and contact counts.
         let augmented = self.augmented();
