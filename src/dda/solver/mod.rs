@@ -52,7 +52,9 @@ fn per_block<T: Copy + Default>(n: usize, mut value: impl FnMut(usize) -> T) -> 
         let values: [T; 4] = std::array::from_fn(|b| if b < n { value(b) } else { T::default() });
         SmallVec::from_buf_and_len(values, n)
     } else {
-        (0..n).map(value).collect()
+        // Collected as a `Vec` (one allocation of the exact size, no test per value)
+        // and handed over: `SmallVec`'s own `collect` grows and tests at each push.
+        SmallVec::from_vec((0..n).map(value).collect())
     }
 }
 
