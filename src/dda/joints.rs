@@ -49,12 +49,21 @@ impl ElementTerms {
         }
     }
 
+    /// Makes these the terms of `nodes` with zero stiffness and force (as
+    /// [`ElementTerms::with_nodes`], in place).
+    fn reset(&mut self, nodes: &[(usize, Point)]) {
+        let n = nodes.len();
+        self.count = n;
+        self.nodes[..n].copy_from_slice(nodes);
+        self.ke[..4 * n * n].fill(0.0);
+        self.fe[..2 * n].fill(0.0);
+    }
+
     /// Adds the stiffness and forces of connection `c`, whose node k is this element's
     /// node `map[k]` (a node's two entries stay side by side).
     fn add_connection(&mut self, c: &Connection, map: &[usize; MAX_NODES]) {
-        let (ke, fe) = c.local_terms();
         let own_dim = 2 * self.count;
-        for (i, (ke_row, f)) in ke.chunks_exact(6).zip(fe).enumerate() {
+        c.for_each_row(|i, ke_row, f| {
             let own_i = 2 * map[i / 2] + i % 2;
             self.fe[own_i] += f;
             for (l, pair) in ke_row.chunks_exact(2).enumerate() {
@@ -62,7 +71,7 @@ impl ElementTerms {
                 self.ke[at] += pair[0];
                 self.ke[at + 1] += pair[1];
             }
-        }
+        });
     }
 
     /// Nodes: (block, current position).
@@ -175,18 +184,29 @@ impl ConnectionGroups {
         Self { groups }
     }
 
-    /// Appends the terms of every group, at the connections' current geometry.
-    pub fn terms_into(&self, connections: &[Connection], out: &mut Vec<ElementTerms>) {
-        for g in &self.groups {
-            let nodes = g.nodes(connections);
-            // Built in place: the terms are larger than the work of filling them.
-            let index = out.len();
-            out.push(ElementTerms::with_nodes(&nodes[..g.nodes]));
-            let terms = &mut out[index];
+    /// Writes the terms of every group, at the connections' current geometry, into
+    /// `out[from..]` (reusing the entries there, appending the rest) and truncates `out`
+    /// after them.
+    pub fn terms_into(&self, connections: &[Connection], out: &mut Vec<ElementTerms>, from: usize) {
+        for (index, g) in (from..).zip(&self.groups) {
+            let nodes = &g.nodes(connections)[..g.nodes];
+            // Built in place: the terms are larger than the work of filling them (a new
+            // element pushed was built aside and copied in).
+            let terms = match out.get_mut(index) {
+                Some(terms) => {
+                    terms.reset(nodes);
+                    terms
+                }
+                None => {
+                    out.push(ElementTerms::with_nodes(nodes));
+                    &mut out[index]
+                }
+            };
             for (map, c) in g.maps.iter().zip(&connections[g.first..g.first + g.len]) {
                 terms.add_connection(c, map);
             }
         }
+        out.truncate(from + self.groups.len());
     }
 
     /// Moves every connection by this step's motion (see [`Connection::commit`]). A node
@@ -576,8 +596,21 @@ impl Connection {
     /// `ke = A Bᵀ C B` (6 × 6, row-major) and `fe = A Bᵀ σ` on the three nodes, node pair
     /// by node pair: B's node block is `[[b, 0], [0, c], [c, b]] / 2A`, so the pair (k, l)
     /// is `[[bₖ, 0, cₖ], [0, cₖ, bₖ]] C [[bₗ, 0], [0, cₗ], [cₗ, bₗ]] / 4A`.
-    #[inline]
     pub fn local_terms(&self) -> ([f64; 36], [f64; 6]) {
+        let mut ke = [0.0; 36];
+        let mut fe = [0.0; 6];
+        self.for_each_row(|i, row, f| {
+            ke[6 * i..6 * i + 6].copy_from_slice(row);
+            fe[i] = f;
+        });
+        (ke, fe)
+    }
+
+    /// Hands each row `i` of [`Connection::local_terms`] to `put`: its six `ke` entries
+    /// and its `fe`. A group adds them straight onto its own nodes (see
+    /// [`ElementTerms::add_connection`]) rather than through a returned copy.
+    #[inline(always)]
+    fn for_each_row(&self, mut put: impl FnMut(usize, &[f64; 6], f64)) {
         let [p1, p2, p3] = self.nodes;
         let two_a = (p2[0] - p1[0]) * (p3[1] - p1[1]) - (p3[0] - p1[0]) * (p2[1] - p1[1]);
         let b = [p2[1] - p3[1], p3[1] - p1[1], p1[1] - p2[1]];
@@ -588,8 +621,6 @@ impl Connection {
         let cb = [c[0], b[0], c[1], b[1], c[2], b[2]];
         let e = &self.elasticity;
         let scale = 1.0 / (2.0 * two_a);
-        let mut ke = [0.0; 36];
-        let mut fe = [0.0; 6];
         for k in 0..3 {
             // Bₖᵀ (2 × 3) times C, row by row.
             let rows = [
@@ -605,17 +636,17 @@ impl Connection {
                 ],
             ];
             let sigma = &self.stress;
-            fe[2 * k] = 0.5 * (b[k] * sigma[0] + c[k] * sigma[2]);
-            fe[2 * k + 1] = 0.5 * (c[k] * sigma[1] + b[k] * sigma[2]);
+            let fe = [
+                0.5 * (b[k] * sigma[0] + c[k] * sigma[2]),
+                0.5 * (c[k] * sigma[1] + b[k] * sigma[2]),
+            ];
             for (r, row) in rows.iter().enumerate() {
                 let alternating = [row[0], row[1], row[0], row[1], row[0], row[1]];
-                let out = &mut ke[(2 * k + r) * 6..(2 * k + r + 1) * 6];
-                for j in 0..6 {
-                    out[j] = scale * (alternating[j] * bc[j] + row[2] * cb[j]);
-                }
+                let ke_row: [f64; 6] =
+                    std::array::from_fn(|j| scale * (alternating[j] * bc[j] + row[2] * cb[j]));
+                put(2 * k + r, &ke_row, fe[r]);
             }
         }
-        (ke, fe)
     }
 
     /// Elastic energy, J: the work the element's forces (`fe`, `ke` of each step) did on
@@ -808,7 +839,7 @@ mod tests {
         }
         let groups = ConnectionGroups::new(&connections);
         let mut terms = Vec::new();
-        groups.terms_into(&connections, &mut terms);
+        groups.terms_into(&connections, &mut terms, 0);
         assert_eq!(terms.len(), 2);
         assert_eq!(terms[0].nodes().len(), 4);
         let u: Vec<Point> = (0..4)

@@ -9,13 +9,21 @@ impl Dda {
         out
     }
 
-    /// This step's terms of every joint, into `out` (cleared first).
+    /// This step's terms of every joint, into `out` (its entries are overwritten: the
+    /// connections' terms are rebuilt in place, see
+    /// [`crate::dda::joints::ConnectionGroups::terms_into`]).
     pub(super) fn element_terms_into(&self, out: &mut Vec<ElementTerms>) {
-        out.clear();
-        out.extend(self.bolts.iter().map(Bolt::terms));
-        out.extend(self.fixed.iter().map(FixedPoint::terms));
+        let joints = self.bolts.iter().map(Bolt::terms);
+        let points = self.fixed.iter().map(FixedPoint::terms);
+        for (index, terms) in joints.chain(points).enumerate() {
+            match out.get_mut(index) {
+                Some(entry) => *entry = terms,
+                None => out.push(terms),
+            }
+        }
         // A connection's triangles share their nodes: merged, each gap is one element.
-        self.connection_groups.terms_into(&self.connections, out);
+        let from = self.bolts.len() + self.fixed.len();
+        self.connection_groups.terms_into(&self.connections, out, from);
     }
 
     /// Makes `self.elements` the terms of the joints as they are now (computing them only
