@@ -69,7 +69,10 @@ pub fn cholesky(s: &mut Mat6, inverse: &mut [f64; 6]) -> Option<()> {
             }
         }
         let pivot = s_t[c][c] - dots[c];
-        if pivot.is_nan() || pivot <= 0.0 {
+        // Not positive, NaN or infinite: an infinite pivot's root would zero its column
+        // (times 1/∞) and hide the infinity; any other NaN or ∞ of the matrix reaches a
+        // later pivot (as the square of its entry of L), so a factor is finite.
+        if !(pivot > 0.0 && pivot < f64::INFINITY) {
             return None;
         }
         let l = pivot.sqrt();

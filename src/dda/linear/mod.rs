@@ -871,7 +871,14 @@ impl LinearSolver {
                 return Ok(());
             }
         }
-        if !k.is_finite() || rhs.iter().any(|v| !v.is_finite()) {
+        if rhs.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NonFinite);
+        }
+        // A NaN or ∞ in the matrix makes the small and envelope factors fail (they refuse
+        // an infinite pivot, and any other reaches one): the matrix is looked through only
+        // when they do, to say why. faer's factor is not relied on for that.
+        let sparse = matches!(self.slots[0].factor, Factor::Sparse(_));
+        if sparse && !k.is_finite() {
             return Err(SolveError::NonFinite);
         }
         // Refactorise the slot of this structure, or the one used least recently.
@@ -882,7 +889,13 @@ impl LinearSolver {
                 1
             }
         });
-        self.factorize(k)?;
+        self.factorize(k).map_err(|e| {
+            if k.is_finite() {
+                e
+            } else {
+                SolveError::NonFinite
+            }
+        })?;
         let slot = &mut self.slots[self.active];
         slot.factored = Some(structure);
         slot.used = self.stats.solves;
@@ -1299,6 +1312,66 @@ pub(super) mod tests {
             solver.solve(&k, &[1.0; 6], 0, &mut x),
             Err(SolveError::NotPositiveDefinite)
         );
+    }
+
+    /// A NaN or an infinity anywhere in the matrix — on a diagonal, below it in a
+    /// diagonal block, in a coupling block — is refused as non-finite, whichever factor
+    /// the size picks (small, envelope, sparse): the small and envelope factors find it
+    /// by failing (see `mat6::cholesky`), not by a look through the matrix first.
+    #[test]
+    fn a_non_finite_matrix_is_refused_by_every_factor() {
+        // 2 blocks: the small factor; 12 on a chain: the envelope; 40 on a ring with
+        // chords: sparse (checked below).
+        let sizes: [(usize, &[(usize, usize)]); 3] = [
+            (2, &[(0, 1)]),
+            (12, &[]),
+            (40, &[(0, 20), (5, 25), (10, 30), (15, 35)]),
+        ];
+        for (blocks, extra) in sizes {
+            let mut pairs: Vec<(usize, usize)> = (0..blocks - 1).map(|i| (i, i + 1)).collect();
+            pairs.extend_from_slice(extra);
+            let base = springs(blocks, &pairs, 7);
+            let kind = format!("{:?}", LinearSolver::new(Arc::clone(base.pattern())).unwrap());
+            let expected = match blocks {
+                2 => "sparse: false, tiny: true",
+                12 => "sparse: false, tiny: false",
+                _ => "sparse: true, tiny: false",
+            };
+            assert!(kind.contains(expected), "{blocks} blocks: {kind}");
+            let positions = [(0, 0, 2, 2), (blocks - 1, blocks - 1, 5, 1), (0, 1, 3, 4)];
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for &(bi, bj, r, c) in &positions {
+                    let mut k = BlockMatrix::zeros(Arc::clone(base.pattern()));
+                    k.copy_from(&base);
+                    let mut m = [[0.0; 6]; 6];
+                    m[r][c] = bad;
+                    k.add(bi, bj, &m, 1.0);
+                    if bi != bj {
+                        k.add(bj, bi, &crate::dda::mat6::transpose(&m), 1.0);
+                    } else {
+                        let mut t = [[0.0; 6]; 6];
+                        t[c][r] = bad;
+                        if r != c {
+                            k.add(bi, bi, &t, 1.0);
+                        }
+                    }
+                    let mut solver = LinearSolver::new(Arc::clone(base.pattern())).unwrap();
+                    let mut x = vec![0.0; 6 * blocks];
+                    let rhs = vec![1.0; 6 * blocks];
+                    assert_eq!(
+                        solver.solve(&k, &rhs, 0, &mut x),
+                        Err(SolveError::NonFinite),
+                        "{blocks} blocks, {bad} at block ({bi}, {bj}) entry ({r}, {c})"
+                    );
+                }
+            }
+            // And the same matrix without it solves.
+            let mut solver = LinearSolver::new(Arc::clone(base.pattern())).unwrap();
+            let mut x = vec![0.0; 6 * blocks];
+            let rhs = vec![1.0; 6 * blocks];
+            solver.solve(&base, &rhs, 0, &mut x).unwrap();
+            assert_solves(&base, &rhs, &x);
+        }
     }
 
     #[test]
