@@ -1331,7 +1331,10 @@ pub(super) mod tests {
             let mut pairs: Vec<(usize, usize)> = (0..blocks - 1).map(|i| (i, i + 1)).collect();
             pairs.extend_from_slice(extra);
             let base = springs(blocks, &pairs, 7);
-            let kind = format!("{:?}", LinearSolver::new(Arc::clone(base.pattern())).unwrap());
+            let kind = format!(
+                "{:?}",
+                LinearSolver::new(Arc::clone(base.pattern())).unwrap()
+            );
             let expected = match blocks {
                 2 => "sparse: false, tiny: true",
                 12 => "sparse: false, tiny: false",

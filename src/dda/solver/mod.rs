@@ -6,6 +6,7 @@ mod damping;
 mod events;
 mod iteration;
 mod ledger;
+mod mass;
 mod stepping;
 mod system;
 

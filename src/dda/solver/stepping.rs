@@ -1,8 +1,8 @@
 //! The step controller: Δt cuts, event landing, integrator restarts, and the commit of a converged step (integrator update, energy booking, geometry).
 
 use super::iteration::yield_stretch;
+use super::mass::{solve_mass, solve_masses};
 use super::*;
-use crate::dda::linear::DenseCholesky;
 
 impl Dda {
     /// Largest vertex displacement of the structure relative to the ground translation,
@@ -910,18 +910,13 @@ impl Dda {
         before: &[Vec6],
         after: &[Vec6],
     ) {
-        for (((b, inertia), f0), f1) in self
-            .blocks
-            .iter_mut()
-            .zip(old_inertia)
-            .zip(before)
-            .zip(after)
-        {
-            if b.role == BlockRole::PrescribedGround {
-                continue;
-            }
-            let force = std::array::from_fn(|i| inertia[i] + f1[i] - f0[i]);
-            let Some(x) = solve_mass(b, &force) else {
+        let forces: PerBlock<Vec6> = per_block(self.blocks.len(), |b| {
+            std::array::from_fn(|i| old_inertia[b][i] + after[b][i] - before[b][i])
+        });
+        let moving = |b: &Block| b.role != BlockRole::PrescribedGround;
+        let solved = solve_masses(&self.blocks, &forces, moving);
+        for (b, x) in self.blocks.iter_mut().zip(solved) {
+            let Some(x) = x else {
                 continue;
             };
             for (i, &xi) in x.iter().enumerate().take(b.moving_unknowns()) {
@@ -930,70 +925,6 @@ impl Dda {
             }
         }
     }
-}
-
-/// M⁻¹ f for a free block's mass matrix M, on the unknowns that move: a rigid block's
-/// strain rows are held (the identity in the factor), and their entries come back zero.
-/// `None` if the mass matrix is not positive definite.
-///
-/// A block's mass matrix does not couple its translations with anything (its first
-/// moments about its centroid vanish: see [`crate::dda::block::mass_matrix`]). Its factor
-/// is then two roots and the factor of the rotation-and-strains block: the same
-/// operations a 6 × 6 factor does, without the ones by the exact zeros, which add ±0
-/// (the same bits). As one 6 × 6 factor, each division waited on the translations' rows
-/// (a tenth of the three-storey frame's time went to these solves, one per block and step).
-fn solve_mass(b: &Block, f: &Vec6) -> Option<Vec6> {
-    let m = &b.mass;
-    let uncoupled = (0..2).all(|i| (0..6).all(|j| i == j || (m[i][j] == 0.0 && m[j][i] == 0.0)));
-    if !uncoupled {
-        return solve_mass_coupled(b, f);
-    }
-    let mut x = [0.0; 6];
-    for i in 0..2 {
-        let pivot = m[i][i];
-        if pivot.is_nan() || pivot <= 0.0 {
-            return None;
-        }
-        // Forward then backward substitution by the root (as the 6 × 6 factor does).
-        let root = pivot.sqrt();
-        x[i] = f[i] / root / root;
-    }
-    let n = b.moving_unknowns() - 2;
-    let mut rest = DenseCholesky::<4>::empty();
-    for j in 0..4 {
-        rest.set(j, j, if j < n { m[j + 2][j + 2] } else { 1.0 });
-        for i in j + 1..n {
-            rest.set(i, j, m[i + 2][j + 2]);
-        }
-    }
-    if !rest.factorize_holding(std::array::from_fn(|j| j >= n)) {
-        return None;
-    }
-    let mut y = [0.0; 4];
-    y[..n].copy_from_slice(&f[2..2 + n]);
-    rest.solve(&mut y);
-    x[2..].copy_from_slice(&y);
-    Some(x)
-}
-
-/// [`solve_mass`] for a mass matrix that couples the translations (not one the model
-/// makes): one 6 × 6 factor.
-fn solve_mass_coupled(b: &Block, f: &Vec6) -> Option<Vec6> {
-    let n = b.moving_unknowns();
-    let mut x = [0.0; 6];
-    x[..n].copy_from_slice(&f[..n]);
-    let mut mass = DenseCholesky::<6>::empty();
-    for j in 0..6 {
-        mass.set(j, j, if j < n { b.mass[j][j] } else { 1.0 });
-        for i in j + 1..n {
-            mass.set(i, j, b.mass[i][j]);
-        }
-    }
-    if !mass.factorize_holding(std::array::from_fn(|j| j >= n)) {
-        return None;
-    }
-    mass.solve(&mut x);
-    Some(x)
 }
 
 /// The start state of a step before its opening contacts were released.
@@ -1056,77 +987,5 @@ mod step_size_tests {
         assert_eq!(step_size(1e-3, 1e-3 + 1e-12), 1e-3 + 1e-12);
         assert_eq!(step_size(1e-3, 5e-4), 5e-4);
         assert_eq!(step_size(1e-3, 2.5e-3), 1e-3);
-    }
-}
-
-#[cfg(test)]
-mod mass_solve_tests {
-    use super::{solve_mass, solve_mass_coupled};
-    use crate::dda::block::Block;
-
-    /// Blocks of several shapes and densities, turned and strained so that every entry of
-    /// the rotation-and-strains part of the mass matrix is non-zero.
-    fn blocks() -> Vec<Block> {
-        let shapes = [
-            vec![[0.0, 0.0], [3.0, 0.5], [2.5, 2.0], [0.8, 2.6], [-0.4, 1.1]],
-            vec![[-12.3, 0.0], [12.3, 0.0], [12.3, 0.3], [-12.3, 0.3]],
-            vec![[1.0, 1.0], [1.4, 1.0], [1.4, 3.5]],
-        ];
-        let mut out = Vec::new();
-        for (k, shape) in shapes.into_iter().enumerate() {
-            let mut b = Block::unit_for_tests(shape);
-            b.material.density = 10f64.powi(k as i32 * 3);
-            b.apply_increment(&[0.1, -0.2, 0.3, 1e-3, -2e-3, 3e-3], true)
-                .expect("a small increment");
-            out.push(b.clone());
-            b.rigid = true;
-            out.push(b);
-        }
-        out
-    }
-
-    #[test]
-    fn the_split_mass_solve_is_the_full_one_to_the_bit() {
-        let forces = [
-            [1.0, -2.0, 3.0, -4.0, 5.0, -6.0],
-            [1e-9, 7.0, -1e3, 0.5, 1e-12, 2.0],
-            [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
-        ];
-        for b in blocks() {
-            for f in &forces {
-                let split = solve_mass(&b, f).expect("positive definite");
-                let full = solve_mass_coupled(&b, f).expect("positive definite");
-                let bits = |x: [f64; 6]| x.map(f64::to_bits);
-                assert_eq!(
-                    bits(split),
-                    bits(full),
-                    "block {:?} rigid {}",
-                    b.mass,
-                    b.rigid
-                );
-                // And it is a solution: M x = f on the unknowns that move.
-                for i in 0..b.moving_unknowns() {
-                    let mx: f64 = (0..6).map(|j| b.mass[i][j] * split[j]).sum();
-                    assert!((mx - f[i]).abs() <= 1e-9 * (1.0 + f[i].abs()), "row {i}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn a_mass_matrix_that_couples_the_translations_is_solved_whole() {
-        let mut b = blocks().remove(0);
-        b.mass[0][2] = 0.1 * b.mass[0][0];
-        b.mass[2][0] = b.mass[0][2];
-        let f = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
-        let x = solve_mass(&b, &f).expect("positive definite");
-        for i in 0..6 {
-            let mx: f64 = (0..6).map(|j| b.mass[i][j] * x[j]).sum();
-            assert!(
-                (mx - f[i]).abs() <= 1e-9 * f[i].abs(),
-                "row {i}: {mx} vs {}",
-                f[i]
-            );
-        }
     }
 }

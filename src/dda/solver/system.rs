@@ -23,7 +23,8 @@ impl Dda {
         }
         // A connection's triangles share their nodes: merged, each gap is one element.
         let from = self.bolts.len() + self.fixed.len();
-        self.connection_groups.terms_into(&self.connections, out, from);
+        self.connection_groups
+            .terms_into(&self.connections, out, from);
     }
 
     /// Makes `self.elements` the terms of the joints as they are now (computing them only
