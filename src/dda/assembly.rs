@@ -195,8 +195,29 @@ impl System {
         centroids: &[Point],
         element: &ElementTerms,
     ) {
+        // At a node count fixed at compile time the loops over node pairs unroll (a
+        // connection group has four nodes, a bolt two, a fixed point one).
+        match element.nodes().len() {
+            4 => self.add_nodal_element_of::<4>(dofs, known, centroids, element),
+            3 => self.add_nodal_element_of::<3>(dofs, known, centroids, element),
+            2 => self.add_nodal_element_of::<2>(dofs, known, centroids, element),
+            1 => self.add_nodal_element_of::<1>(dofs, known, centroids, element),
+            // `ElementTerms` holds 1 to `MAX_NODES` nodes.
+            count => debug_assert!(false, "an element of {count} nodes"),
+        }
+    }
+
+    /// [`System::add_nodal_element`] of an element of `N` nodes.
+    fn add_nodal_element_of<const N: usize>(
+        &mut self,
+        dofs: &DofMap,
+        known: &[Vec6],
+        centroids: &[Point],
+        element: &ElementTerms,
+    ) {
         let (nodes, ke, fe) = (element.nodes(), element.ke(), element.fe());
-        let n = nodes.len();
+        debug_assert_eq!(nodes.len(), N, "an element of N nodes");
+        let n = N;
         let dim = 2 * n;
         let c = self.stiffness_factor;
         // Node offsets from their blocks' centroids: Tᵀ·v is formed from them directly.
