@@ -72,6 +72,8 @@ pub(super) struct SparseCholesky {
     permuted: Arc<PermutedPattern>,
     l_values: Vec<f64>,
     a_values: Vec<f64>,
+    /// The right-hand side in the factor's ordering (a simplicial solve's).
+    work: Vec<f64>,
 }
 
 impl SparseCholesky {
@@ -98,6 +100,7 @@ impl SparseCholesky {
         Self {
             l_values: vec![0.0; symbolic.len_val()],
             a_values: vec![0.0; permuted.position.len()],
+            work: Vec::new(),
             symbolic: Arc::new(symbolic),
             permuted: Arc::new(permuted),
         }
@@ -110,6 +113,7 @@ impl SparseCholesky {
             permuted: Arc::clone(&self.permuted),
             l_values: vec![0.0; self.l_values.len()],
             a_values: vec![0.0; self.a_values.len()],
+            work: Vec::new(),
         }
     }
 
@@ -171,15 +175,77 @@ impl SparseCholesky {
     }
 
     /// x ← K⁻¹ x with the factor.
-    pub(super) fn solve(&self, x: &mut [f64], stack: &mut MemStack) {
-        let n = x.len();
-        let rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
-        LltRef::<'_, usize, f64>::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            Par::Seq,
-            stack,
-        );
+    pub(super) fn solve(&mut self, x: &mut [f64], stack: &mut MemStack) {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let perm = self.symbolic.perm().map(|p| p.arrays());
+                solve_simplicial(s.factor(), &self.l_values, perm, x, &mut self.work);
+            }
+            SymbolicCholeskyRaw::Supernodal(_) => {
+                let n = x.len();
+                let rhs = faer::MatMut::from_column_major_slice_mut(x, n, 1);
+                LltRef::<'_, usize, f64>::new(&self.symbolic, &self.l_values)
+                    .solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+            }
+        }
+    }
+}
+
+/// x ← (L Lᵀ)⁻¹ x for a simplicial factor L (its columns' first entries the diagonal) on
+/// the ordering `perm` (forward, inverse): faer's own solve, its operations in its order
+/// (`solve_lower_triangular_in_place` and its transpose, one right-hand side), so the
+/// same bits. Through faer it was compiled with the conjugation a run-time argument in
+/// some builds of this crate and inlined in others, and the walls' solves moved by a
+/// quarter of their instructions with unrelated edits; this one does not depend on that.
+fn solve_simplicial(
+    l: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+    values: &[f64],
+    perm: Option<(&[usize], &[usize])>,
+    x: &mut [f64],
+    work: &mut Vec<f64>,
+) {
+    let n = x.len();
+    let (col_ptr, row_idx) = (l.col_ptr(), l.row_idx());
+    let y: &mut [f64] = match perm {
+        Some((forward, _)) => {
+            work.clear();
+            work.extend(forward.iter().map(|&from| x[from]));
+            work
+        }
+        None => x,
+    };
+    let y = &mut y[..n];
+    // Column j of L: its diagonal, then the rows below it and their values.
+    let column = |j: usize| {
+        let (start, end) = (col_ptr[j], col_ptr[j + 1]);
+        (
+            values[start],
+            &row_idx[start + 1..end],
+            &values[start + 1..end],
+        )
+    };
+    // L y = x, column by column: times the diagonal's reciprocal, then the column below.
+    for j in 0..n {
+        let (diagonal, rows, below) = column(j);
+        let yj = y[j] * diagonal.recip();
+        y[j] = yj;
+        for (&i, &lij) in rows.iter().zip(below) {
+            y[i] -= lij * yj;
+        }
+    }
+    // Lᵀ x = y, backwards: each column's dot product from its last entry up.
+    for j in (0..n).rev() {
+        let (diagonal, rows, below) = column(j);
+        let mut sum = 0.0;
+        for (&i, &lij) in rows.iter().zip(below).rev() {
+            sum += lij * y[i];
+        }
+        y[j] = (y[j] - sum) * diagonal.recip();
+    }
+    if let Some((_, inverse)) = perm {
+        for (xi, &from) in x.iter_mut().zip(inverse) {
+            *xi = work[from];
+        }
     }
 }
 
@@ -196,6 +262,64 @@ fn read_side(symbolic: &SymbolicCholesky<usize>) -> Side {
 mod tests {
     use super::*;
     use crate::dda::linear::tests::{chain, springs};
+
+    /// Our simplicial solve is faer's, to the bit, with and without a fill-reducing
+    /// ordering, on factors faer analyses as simplicial (and faer's supernodal path is
+    /// still taken for the rest).
+    #[test]
+    fn the_simplicial_solve_is_faer_s_own_to_the_bit() {
+        let mut simplicial_cases = 0;
+        for (k, seed) in [
+            (chain(40, 7), 1),
+            (chain(25, 2), 2),
+            (springs(30, &[(0, 29)], 5), 3),
+        ] {
+            let pattern = k.pattern();
+            let symbolic = SparseCholesky::analyse(pattern).unwrap();
+            let mut ours = SparseCholesky::new(pattern, symbolic);
+            let mut buffer = MemBuffer::new(ours.scratch());
+            ours.factorize(&k, MemStack::new(&mut buffer)).unwrap();
+            if !matches!(ours.symbolic.raw(), SymbolicCholeskyRaw::Simplicial(_)) {
+                continue;
+            }
+            simplicial_cases += 1;
+            assert!(ours.symbolic.perm().is_some(), "an AMD ordering");
+            let mut next = crate::dda::linear::tests::pseudo_random(seed);
+            let rhs: Vec<f64> = (0..pattern.unknowns()).map(|_| next() * 1e3).collect();
+            let mut theirs = rhs.clone();
+            let n = theirs.len();
+            LltRef::<'_, usize, f64>::new(&ours.symbolic, &ours.l_values).solve_in_place_with_conj(
+                Conj::No,
+                faer::MatMut::from_column_major_slice_mut(&mut theirs, n, 1),
+                Par::Seq,
+                MemStack::new(&mut buffer),
+            );
+            let mut mine = rhs.clone();
+            ours.solve(&mut mine, MemStack::new(&mut buffer));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&mine), bits(&theirs));
+            // Without the ordering: the factor's own order.
+            let SymbolicCholeskyRaw::Simplicial(s) = ours.symbolic.raw() else {
+                unreachable!()
+            };
+            let mut plain = rhs.clone();
+            let mut work = Vec::new();
+            solve_simplicial(s.factor(), &ours.l_values, None, &mut plain, &mut work);
+            let mut reference = rhs.clone();
+            simplicial::SimplicialLltRef::<'_, usize, f64>::new(s, &ours.l_values)
+                .solve_in_place_with_conj(
+                    Conj::No,
+                    faer::MatMut::from_column_major_slice_mut(&mut reference, n, 1),
+                    Par::Seq,
+                    MemStack::new(&mut buffer),
+                );
+            assert_eq!(bits(&plain), bits(&reference));
+        }
+        assert!(
+            simplicial_cases >= 2,
+            "simplicial factors: {simplicial_cases}"
+        );
+    }
 
     /// The factor from the values written in place is faer's own (which permutes the
     /// matrix at each call), to the bit, on a ring and on a grid of blocks.
