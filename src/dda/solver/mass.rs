@@ -13,7 +13,8 @@ use super::per_block;
 use crate::dda::block::{Block, Mat6, Vec6};
 use crate::dda::linear::DenseCholesky;
 
-/// Blocks factorised side by side (four `f64` fill a 256-bit vector).
+/// Blocks factorised side by side: four, two vectors of two `f64` in the baseline
+/// x86-64 build (one vector where AVX is enabled), whose chains overlap.
 const LANES: usize = 4;
 
 /// M⁻¹ f of every block for which `wanted` holds (`None` for the others, and for a
