@@ -54,9 +54,11 @@ impl ElementTerms {
     fn reset(&mut self, nodes: &[(usize, Point)]) {
         let n = nodes.len();
         self.count = n;
+        self.nodes = [(0, [0.0; 2]); MAX_NODES];
         self.nodes[..n].copy_from_slice(nodes);
-        self.ke[..4 * n * n].fill(0.0);
-        self.fe[..2 * n].fill(0.0);
+        // All of it, as `with_nodes` does: the entry may have held a larger element.
+        self.ke.fill(0.0);
+        self.fe.fill(0.0);
     }
 
     /// Adds the stiffness and forces of connection `c`, whose node k is this element's
