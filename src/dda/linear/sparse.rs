@@ -8,6 +8,9 @@
 //! value moves to; a factorisation then writes the values straight into their permuted
 //! places and calls faer's numeric factorisation on the permuted matrix. Values are moved,
 //! never combined, so the factor is the same to the bit.
+//!
+//! A simplicial factor is applied by our own triangular solves ([`solve_simplicial`]),
+//! faer's operations in faer's order; a supernodal one by faer's.
 
 use std::sync::Arc;
 
