@@ -1320,8 +1320,8 @@ pub(super) mod tests {
     /// by failing (see `mat6::cholesky`), not by a look through the matrix first.
     #[test]
     fn a_non_finite_matrix_is_refused_by_every_factor() {
-        // 2 blocks: the small factor; 12 on a chain: the envelope; 40 on a ring with
-        // chords: sparse (checked below).
+        // 2 blocks: the small factor; 12 on a chain: the envelope; 40 on a chain with
+        // chords across it: sparse (each checked below).
         let sizes: [(usize, &[(usize, usize)]); 3] = [
             (2, &[(0, 1)]),
             (12, &[]),
