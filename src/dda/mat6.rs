@@ -53,6 +53,16 @@ pub fn subtract_product_transposed(s: &mut Mat6, a: &Mat6, b: &Mat6) {
     }
 }
 
+/// Whether a Cholesky factor can take `pivot` as it comes to a diagonal entry: positive
+/// and finite. Not NaN, and not infinite either: an infinite pivot's root would zero its
+/// column (times 1/∞) and hide the infinity, while any other NaN or ∞ of the matrix
+/// reaches a later pivot (as the square of its entry of L). So a factor made is finite,
+/// and the matrix need not be looked through first. Every Cholesky factor here decides
+/// by this.
+pub fn factorable(pivot: f64) -> bool {
+    pivot > 0.0 && pivot < f64::INFINITY
+}
+
 /// The lower Cholesky factor L of the symmetric positive definite `s` (its lower half
 /// read), in place, its upper half zeroed; the reciprocals of L's diagonal into
 /// `inverse`. `None` if `s` is not positive definite (or not finite). Column by column on
@@ -69,10 +79,7 @@ pub fn cholesky(s: &mut Mat6, inverse: &mut [f64; 6]) -> Option<()> {
             }
         }
         let pivot = s_t[c][c] - dots[c];
-        // Not positive, NaN or infinite: an infinite pivot's root would zero its column
-        // (times 1/∞) and hide the infinity; any other NaN or ∞ of the matrix reaches a
-        // later pivot (as the square of its entry of L), so a factor is finite.
-        if !(pivot > 0.0 && pivot < f64::INFINITY) {
+        if !factorable(pivot) {
             return None;
         }
         let l = pivot.sqrt();

@@ -108,10 +108,9 @@ impl<const N: usize> DenseCholesky<N> {
                 }
             }
             let pivot = c[j][j];
-            // nalgebra's `try_sqrt`: nothing for a zero, negative or NaN pivot; nor for an
-            // infinite one, whose root would zero its column and hide the infinity (any
-            // other NaN or ∞ of the matrix reaches a later pivot: a factor is finite).
-            if !(pivot > 0.0 && pivot < f64::INFINITY) {
+            // nalgebra's `try_sqrt` refuses a zero, negative or NaN pivot; an infinite one
+            // is refused too (see `factorable`).
+            if !crate::dda::mat6::factorable(pivot) {
                 return false;
             }
             let root = pivot.sqrt();

@@ -12,6 +12,7 @@ use super::PerBlock;
 use super::per_block;
 use crate::dda::block::{Block, Mat6, Vec6};
 use crate::dda::linear::DenseCholesky;
+use crate::dda::mat6::factorable;
 
 /// Blocks factorised side by side: four, two vectors of two `f64` in the baseline
 /// x86-64 build (one vector where AVX is enabled), whose chains overlap.
@@ -65,9 +66,32 @@ fn translations_uncoupled(m: &Mat6) -> bool {
     (0..2).all(|i| (0..6).all(|j| i == j || (m[i][j] == 0.0 && m[j][i] == 0.0)))
 }
 
-/// Whether a pivot can be factorised (as [`DenseCholesky`] decides).
-fn factorable(pivot: f64) -> bool {
-    pivot > 0.0 && pivot < f64::INFINITY
+/// M⁻¹ f on translation `i` alone (0 or 1: its own 1 × 1 factor), the root's forward
+/// then backward substitution, as a 6 × 6 factor does them. `None` if the pivot cannot be
+/// factorised.
+fn solve_translation(m: &Mat6, f: &Vec6, i: usize) -> Option<f64> {
+    let pivot = m[i][i];
+    if !factorable(pivot) {
+        return None;
+    }
+    let root = pivot.sqrt();
+    Some(f[i] / root / root)
+}
+
+/// The factor of M's unknowns `from..from + N`, holding those from `moving` on (a rigid
+/// block's strains: the identity's rows in the factor). `None` if not positive definite.
+fn held_factor<const N: usize>(m: &Mat6, from: usize, moving: usize) -> Option<DenseCholesky<N>> {
+    let n = moving - from;
+    let mut factor = DenseCholesky::<N>::empty();
+    for j in 0..N {
+        factor.set(j, j, if j < n { m[from + j][from + j] } else { 1.0 });
+        for i in j + 1..n {
+            factor.set(i, j, m[from + i][from + j]);
+        }
+    }
+    factor
+        .factorize_holding(std::array::from_fn(|j| j >= n))
+        .then_some(factor)
 }
 
 /// [`solve_mass`] of `L` deformable blocks whose translations are uncoupled, lane by
@@ -76,14 +100,9 @@ fn factorable(pivot: f64) -> bool {
 /// definite.
 fn solve_deformable_lanes<const L: usize>(m: [&Mat6; L], f: [&Vec6; L]) -> Option<[Vec6; L]> {
     let mut x = [[0.0; 6]; L];
-    for i in 0..2 {
-        for l in 0..L {
-            let pivot = m[l][i][i];
-            if pivot.is_nan() || pivot <= 0.0 {
-                return None;
-            }
-            let root = pivot.sqrt();
-            x[l][i] = f[l][i] / root / root;
+    for (l, xl) in x.iter_mut().enumerate() {
+        for i in 0..2 {
+            xl[i] = solve_translation(m[l], f[l], i)?;
         }
     }
     // c[j][i][l]: column j, row i ≥ j of lane l's 4 × 4 factor (its matrix at first).
@@ -165,48 +184,22 @@ pub(super) fn solve_mass(b: &Block, f: &Vec6) -> Option<Vec6> {
     }
     let mut x = [0.0; 6];
     for i in 0..2 {
-        let pivot = m[i][i];
-        if pivot.is_nan() || pivot <= 0.0 {
-            return None;
-        }
-        // Forward then backward substitution by the root (as the 6 × 6 factor does).
-        let root = pivot.sqrt();
-        x[i] = f[i] / root / root;
+        x[i] = solve_translation(m, f, i)?;
     }
-    let n = b.moving_unknowns() - 2;
-    let mut rest = DenseCholesky::<4>::empty();
-    for j in 0..4 {
-        rest.set(j, j, if j < n { m[j + 2][j + 2] } else { 1.0 });
-        for i in j + 1..n {
-            rest.set(i, j, m[i + 2][j + 2]);
-        }
-    }
-    if !rest.factorize_holding(std::array::from_fn(|j| j >= n)) {
-        return None;
-    }
-    let mut y = [0.0; 4];
-    y[..n].copy_from_slice(&f[2..2 + n]);
-    rest.solve(&mut y);
-    x[2..].copy_from_slice(&y);
+    let moving = b.moving_unknowns();
+    let rest = held_factor::<4>(m, 2, moving)?;
+    x[2..moving].copy_from_slice(&f[2..moving]);
+    rest.solve(&mut x[2..]);
     Some(x)
 }
 
 /// [`solve_mass`] for a mass matrix that couples the translations (not one the model
 /// makes): one 6 × 6 factor.
 fn solve_mass_coupled(b: &Block, f: &Vec6) -> Option<Vec6> {
-    let n = b.moving_unknowns();
+    let moving = b.moving_unknowns();
+    let mass = held_factor::<6>(&b.mass, 0, moving)?;
     let mut x = [0.0; 6];
-    x[..n].copy_from_slice(&f[..n]);
-    let mut mass = DenseCholesky::<6>::empty();
-    for j in 0..6 {
-        mass.set(j, j, if j < n { b.mass[j][j] } else { 1.0 });
-        for i in j + 1..n {
-            mass.set(i, j, b.mass[i][j]);
-        }
-    }
-    if !mass.factorize_holding(std::array::from_fn(|j| j >= n)) {
-        return None;
-    }
+    x[..moving].copy_from_slice(&f[..moving]);
     mass.solve(&mut x);
     Some(x)
 }
@@ -262,6 +255,24 @@ mod tests {
                     assert!((mx - f[i]).abs() <= 1e-9 * (1.0 + f[i].abs()), "row {i}");
                 }
             }
+        }
+    }
+
+    /// An infinite or NaN pivot is refused by the split solve as by the whole one (the
+    /// rule every factor here decides by, `mat6::factorable`).
+    #[test]
+    fn the_split_and_the_whole_solve_refuse_the_same_pivots() {
+        let f = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        for (i, bad) in [
+            (0, f64::INFINITY),
+            (1, f64::NAN),
+            (1, 0.0),
+            (4, f64::INFINITY),
+        ] {
+            let mut b = blocks().remove(0);
+            b.mass[i][i] = bad;
+            assert_eq!(solve_mass(&b, &f), None, "M[{i}][{i}] = {bad}");
+            assert_eq!(solve_mass_coupled(&b, &f), None, "M[{i}][{i}] = {bad}");
         }
     }
 
