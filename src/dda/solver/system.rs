@@ -13,13 +13,11 @@ impl Dda {
     /// connections' terms are rebuilt in place, see
     /// [`crate::dda::joints::ConnectionGroups::terms_into`]).
     pub(super) fn element_terms_into(&self, out: &mut Vec<ElementTerms>) {
-        let joints = self.bolts.iter().map(Bolt::terms);
-        let points = self.fixed.iter().map(FixedPoint::terms);
-        for (index, terms) in joints.chain(points).enumerate() {
-            match out.get_mut(index) {
-                Some(entry) => *entry = terms,
-                None => out.push(terms),
-            }
+        for (index, bolt) in self.bolts.iter().enumerate() {
+            bolt.terms_into(out, index);
+        }
+        for (index, point) in (self.bolts.len()..).zip(&self.fixed) {
+            point.terms_into(out, index);
         }
         // A connection's triangles share their nodes: merged, each gap is one element.
         let from = self.bolts.len() + self.fixed.len();
