@@ -350,7 +350,9 @@ impl Dda {
         mut increments: PerBlock<Vec6>,
     ) -> Result<PerBlock<Vec6>> {
         const MAX_ITERATIONS: usize = 200;
-        let mut change = vec![0.0; self.dofs.n];
+        // Inline for the systems the linear solver factorises on the stack (a heap vector
+        // was the two-block's one allocation a step).
+        let mut change: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
         let mut refine = self.linear.last_solve_iterated();
         for _ in 0..MAX_ITERATIONS {
             self.counters.constraint_iterations += 1;
