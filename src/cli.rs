@@ -500,8 +500,11 @@ fn cmd_run(args: RunArgs) -> Result<()> {
         s.friction
             .map_or("∞ (fixed base)".into(), |f| f.to_string()),
         s.excitation,
-        s.freq_ratio
-            .map_or(String::new(), |r| format!(" Ω/ω = {r:.4}")),
+        with_vertical(
+            &s.freq_ratio
+                .map_or(String::new(), |r| format!(" Ω/ω = {r:.4}")),
+            s.vertical_record.as_deref()
+        ),
         s.duration_s
     ))?;
     out(&format!(
@@ -743,6 +746,15 @@ fn run_header(
     format!("{scene} ({model}{integrator}), {record}, {friction}, {duration_s:.2} s")
 }
 
+/// The horizontal excitation's label with the vertical record's, if the run has one (so
+/// that the summary says it was applied: the results alone do not show it).
+fn with_vertical(horizontal: &str, vertical: Option<&str>) -> String {
+    match vertical {
+        Some(v) => format!("{horizontal} + vertical {v}"),
+        None => horizontal.to_string(),
+    }
+}
+
 /// Prints a run's warnings on stderr (the JSON carries them too).
 fn warn(warnings: &[String]) {
     for w in warnings {
@@ -768,7 +780,7 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         &s.scene,
         &s.model,
         s.integrator.as_deref(),
-        &s.record,
+        &with_vertical(&s.record, s.vertical_record.as_deref()),
         friction,
         s.duration_s,
     ))?;
@@ -835,7 +847,7 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         &s.scene,
         &s.model,
         s.integrator.as_deref(),
-        &s.record,
+        &with_vertical(&s.record, s.vertical_record.as_deref()),
         friction,
         s.duration_s,
     ))?;

@@ -416,3 +416,30 @@ fn friction_law_runs_or_is_refused_by_name() {
         assert!(err.contains(says), "{args:?}: '{err}' lacks '{says}'");
     }
 }
+
+/// The text summary names the vertical record when the run has one: the numbers alone do
+/// not show that it was applied, and a flag that seemed ignored would be re-run without.
+#[test]
+fn a_vertical_record_is_named_in_the_summary() {
+    for scene in ["two-block", "three-storey", "block"] {
+        let out = slidebase(&[
+            "run",
+            "--scene",
+            scene,
+            "--record",
+            "el-centro",
+            "--vertical-record",
+            "el-centro-up",
+            "--duration",
+            "0.2",
+        ]);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{scene}: {out:?}");
+        assert!(
+            text.lines()
+                .next()
+                .is_some_and(|l| l.contains("+ vertical el-centro-up")),
+            "{scene}: {text}"
+        );
+    }
+}

@@ -933,3 +933,15 @@ fn a_scene_friction_law_is_kept_by_both_models() {
         Friction::Coulomb(0.1)
     );
 }
+
+/// An absurd duration is refused in one readable line: the hours it would take in
+/// scientific notation, not a 300-digit number.
+#[test]
+fn an_absurd_duration_is_refused_in_a_readable_line() {
+    let e = spec_error(RunSpec {
+        duration: Some(1e300),
+        ..RunSpec::default()
+    });
+    assert_has(&e, &["1.000e303 steps", "9.3e293 h", "--confirm-large"]);
+    assert!(e.len() < 400, "{} characters: {e}", e.len());
+}

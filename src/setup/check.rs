@@ -239,12 +239,15 @@ pub fn exact_steps_for(f_max: f64, motion: &GroundMotion, duration: f64) -> f64 
 pub fn check_steps(steps: f64, what: &str, confirmed: bool) -> Result<()> {
     if steps > MAX_STEPS && !confirmed {
         // The fastest model (two blocks) takes about 3e5 steps per second.
-        let hours = steps / 3e5 / 3600.0;
+        let hours = match steps / 3e5 / 3600.0 {
+            h if h < 1e5 => format!("{h:.1}"),
+            h => format!("{h:.1e}"),
+        };
         return Err(Error::invalid(
             "--duration/--dt",
             format!(
                 "{what} would take {steps:.3e} steps, beyond the limit of {MAX_STEPS:e} \
-                 (at least {hours:.1} h of computing at the two-block model's 3e5 steps/s); \
+                 (at least {hours} h of computing at the two-block model's 3e5 steps/s); \
                  shorten --duration, enlarge --dt, or give --confirm-large to run it anyway"
             ),
         ));
