@@ -69,8 +69,14 @@ impl Dda {
                 self.params.max_open_close_passes.min(SETTLE_PASSES)
             }
         };
-        // Inline for the systems the linear solver factorises on the stack.
-        let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
+        // Inline for the systems the linear solver factorises on the stack. These and the
+        // per-block vectors below are filled in place at every pass: a two-block step's
+        // vectors are ~200 bytes each, and handing them out by value copied each one
+        // (a tenth of its time went to such copies).
+        let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::new();
+        solution.resize(self.dofs.n, 0.0);
+        let mut increments: PerBlock<Vec6> = PerBlock::new();
+        let mut velocities: PerBlock<Vec6> = PerBlock::new();
         let mut unsettled = Unsettled::StatesChanging;
         // In a dynamic step's last quarter of the passes (at least its last pass) a contact
         // still changing between stuck and sliding keeps its state (see below): the passes
@@ -79,13 +85,14 @@ impl Dda {
         for pass in 1..=max_passes {
             let holding_stick_slip =
                 pass >= holds_stick_slip_from && matches!(mode, Mode::Dynamic { .. });
-            let increments = self.solve_pass(mode, known, base, &mut solution)?;
-            let velocities = match mode {
-                Mode::Dynamic { dt } => self.end_velocities(&increments, dt),
+            self.solve_pass(mode, known, base, &mut solution, &mut increments)?;
+            match mode {
+                Mode::Dynamic { dt } => self.end_velocities_into(&increments, dt, &mut velocities),
                 Mode::Static { .. } | Mode::Modal => {
-                    PerBlock::from_elem([0.0; 6], self.blocks.len())
+                    velocities.clear();
+                    velocities.resize(self.blocks.len(), [0.0; 6]);
                 }
-            };
+            }
             let augmented = self.augmented();
             let mut states_changed = false;
             let mut friction_changed = false;
@@ -297,14 +304,15 @@ impl Dda {
     /// Solves one open-close pass with the contacts' trial states: one linear solve with
     /// penalty springs, or, with the augmented Lagrangian, solves with the same matrix
     /// until every closed contact's constraint holds, updating the multipliers
-    /// (λ ← λ − p·g) after each. Returns the increments of all blocks.
+    /// (λ ← λ − p·g) after each. Writes the increments of all blocks into `increments`.
     pub(super) fn solve_pass(
         &mut self,
         mode: Mode,
         known: &[Vec6],
         base: &System,
         solution: &mut SmallVec<[f64; TINY_LIMIT]>,
-    ) -> Result<PerBlock<Vec6>> {
+        increments: &mut PerBlock<Vec6>,
+    ) -> Result<()> {
         let mut sys = match self.pass_system.take() {
             Some(mut sys) => {
                 sys.copy_from(base);
@@ -319,15 +327,15 @@ impl Dda {
             .linear
             .solve(&sys.k, sys.r.as_slice(), structure, solution);
         let result = solved.map_err(|e| self.solve_error(e)).and_then(|()| {
-            let mut increments = self.increments(solution, known);
+            self.increments_into(solution, known, increments);
             if !self.augmented() {
                 if self.linear.last_solve_iterated() {
                     let mut residual = vec![0.0; self.dofs.n];
                     self.add_residual(&sys, solution, &mut residual);
                     self.solve_correction(&sys, &residual, structure, solution, true)?;
-                    increments = self.increments(solution, known);
+                    self.increments_into(solution, known, increments);
                 }
-                return Ok(increments);
+                return Ok(());
             }
             self.settle_multipliers(&sys, known, structure, solution, increments)
         });
@@ -340,24 +348,25 @@ impl Dda {
     /// matrix stays, only the multipliers' part of the right-hand side changes (λ enters
     /// as −λ·∇g of the constraint energy). A first solve by conjugate gradients is
     /// refined: its residual is solved with the first change of the multipliers, or
-    /// alone if they need none. Returns the increments of all blocks.
+    /// alone if they need none. `increments` are those of `solution` and are kept so.
     fn settle_multipliers(
         &mut self,
         sys: &System,
         known: &[Vec6],
         structure: u64,
         solution: &mut [f64],
-        mut increments: PerBlock<Vec6>,
-    ) -> Result<PerBlock<Vec6>> {
+        increments: &mut PerBlock<Vec6>,
+    ) -> Result<()> {
         const MAX_ITERATIONS: usize = 200;
         // Inline for the systems the linear solver factorises on the stack (a heap vector
         // was the two-block's one allocation a step).
-        let mut change: SmallVec<[f64; TINY_LIMIT]> = SmallVec::from_elem(0.0, self.dofs.n);
+        let mut change: SmallVec<[f64; TINY_LIMIT]> = SmallVec::new();
+        change.resize(self.dofs.n, 0.0);
         let mut refine = self.linear.last_solve_iterated();
         for _ in 0..MAX_ITERATIONS {
             self.counters.constraint_iterations += 1;
             change.fill(0.0);
-            let settled = self.update_multipliers(&increments, &mut change);
+            let settled = self.update_multipliers(increments, &mut change);
             if settled && !refine {
                 break;
             }
@@ -368,9 +377,9 @@ impl Dda {
             }
             self.solve_correction(sys, &change, structure, solution, settled)?;
             refine = false;
-            increments = self.increments(solution, known);
+            self.increments_into(solution, known, increments);
         }
-        Ok(increments)
+        Ok(())
     }
 
     /// Adds the residual R − K x of the pass's system at `solution` to `out`. Conjugate
@@ -488,35 +497,33 @@ impl Dda {
     }
 
     /// Velocities at the end of a trial step (Newmark update; the prescribed ground's
-    /// from the motion), used to judge slip reversals.
-    pub(super) fn end_velocities(&self, increments: &[Vec6], dt: f64) -> PerBlock<Vec6> {
+    /// from the motion), used to judge slip reversals, into `out`.
+    fn end_velocities_into(&self, increments: &[Vec6], dt: f64, out: &mut PerBlock<Vec6>) {
         let c = &self.coeffs;
-        per_block(self.blocks.len(), |bi| {
-            let (b, d) = (&self.blocks[bi], &increments[bi]);
-            match b.role {
-                BlockRole::PrescribedGround => [0.0; 6],
-                _ => {
-                    let mut v = [0.0; 6];
-                    for k in 0..6 {
-                        let a_new = c.end_accel(d[k], b.velocity[k], b.accel[k], dt);
-                        v[k] = c.end_velocity(b.velocity[k], b.accel[k], a_new, dt);
-                    }
-                    v
-                }
-            }
-        })
+        out.clear();
+        out.extend(self.blocks.iter().zip(increments).map(|(b, d)| match b.role {
+            BlockRole::PrescribedGround => [0.0; 6],
+            _ => std::array::from_fn(|k| {
+                let a_new = c.end_accel(d[k], b.velocity[k], b.accel[k], dt);
+                c.end_velocity(b.velocity[k], b.accel[k], a_new, dt)
+            }),
+        }));
     }
 
     /// Increments of all blocks from the solution vector and the known ones.
     pub(super) fn increments(&self, solution: &[f64], known: &[Vec6]) -> PerBlock<Vec6> {
-        per_block(self.blocks.len(), |b| match self.dofs.slot[b] {
-            Some(s) => {
-                let mut d = [0.0; 6];
-                d.copy_from_slice(&solution[s..s + 6]);
-                d
-            }
-            None => known[b],
-        })
+        let mut out = PerBlock::new();
+        self.increments_into(solution, known, &mut out);
+        out
+    }
+
+    /// [`Dda::increments`] into `out`.
+    fn increments_into(&self, solution: &[f64], known: &[Vec6], out: &mut PerBlock<Vec6>) {
+        out.clear();
+        out.extend(self.dofs.slot.iter().zip(known).map(|(slot, known)| match *slot {
+            Some(s) => std::array::from_fn(|k| solution[s + k]),
+            None => *known,
+        }));
     }
 }
 
