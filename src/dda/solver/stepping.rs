@@ -726,7 +726,8 @@ impl Dda {
         }
         // The forces this step balanced at its end, to be compared with those of the
         // geometry it moves to (see `rebalance_accelerations`).
-        let before = self.configuration_forces(Some(increments));
+        let mut before = PerBlock::new();
+        self.configuration_forces(Some(increments), &mut before);
         let old_inertia: PerBlock<Vec6> = per_block(self.blocks.len(), |bi| {
             let b = &self.blocks[bi];
             let mut f = [0.0; 6];
@@ -738,10 +739,10 @@ impl Dda {
         self.commit_geometry(increments)?;
         // The contacts' forces at the step's end (in the memory just written) along the
         // step's gradients.
-        let mut before = before;
         self.add_contact_forces(&mut before);
-        let after = self.configuration_forces(None);
-        self.rebalance_accelerations(&old_inertia, &before, &after);
+        let mut after = PerBlock::new();
+        self.configuration_forces(None, &mut after);
+        self.rebalance_accelerations(&old_inertia, &before, &mut after);
         self.time = t_new;
 
         let e = &mut self.energy;
@@ -806,9 +807,15 @@ impl Dda {
     /// of the step the increments were solved with (the forces that step balanced; the
     /// contacts' are added by the caller once their memory holds the end values);
     /// without, their values at the current geometry, contacts included (the forces the
-    /// next step starts from).
-    pub(super) fn configuration_forces(&mut self, increments: Option<&[Vec6]>) -> PerBlock<Vec6> {
-        let mut out: PerBlock<Vec6> = per_block(self.blocks.len(), |_| [0.0; 6]);
+    /// next step starts from). Written into `out` (filled in place: a two-block step's
+    /// forces returned by value were a 200-byte copy each).
+    pub(super) fn configuration_forces(
+        &mut self,
+        increments: Option<&[Vec6]>,
+        out: &mut PerBlock<Vec6>,
+    ) {
+        out.clear();
+        out.resize(self.blocks.len(), [0.0; 6]);
         let centroids = self.centroids();
         let zero = [0.0; 6];
         let inc = |b: usize| increments.map_or(&zero, |d| &d[b]);
@@ -864,11 +871,10 @@ impl Dda {
             // Along the directions the next step will hold them along, so that its forces
             // at both ends act along the same normal (square to a dish contact's chord).
             self.follow_curvature(self.grown_step());
-            self.add_contact_forces(&mut out);
+            self.add_contact_forces(out);
             std::mem::swap(&mut self.contacts, &mut self.spare_contacts);
             self.detection_for_next_step = Some(self.coeffs.beta);
         }
-        out
     }
 
     /// The nominal size of the step after an accepted one: back towards Δt after a cut.
@@ -904,17 +910,19 @@ impl Dda {
     /// against a gravity preload (the three-storey frame gained energy from gravity and
     /// crept from its settled state). The accelerations take up the difference instead,
     /// so each step's trapezoidal work is exactly the change of the stored energy.
+    /// `after` is overwritten with the forces the accelerations take up.
     pub(super) fn rebalance_accelerations(
         &mut self,
         old_inertia: &[Vec6],
         before: &[Vec6],
-        after: &[Vec6],
+        after: &mut [Vec6],
     ) {
-        let forces: PerBlock<Vec6> = per_block(self.blocks.len(), |b| {
-            std::array::from_fn(|i| old_inertia[b][i] + after[b][i] - before[b][i])
-        });
+        for ((f, old), before) in after.iter_mut().zip(old_inertia).zip(before) {
+            *f = std::array::from_fn(|i| old[i] + f[i] - before[i]);
+        }
+        let forces = after;
         let moving = |b: &Block| b.role != BlockRole::PrescribedGround;
-        let solved = solve_masses(&self.blocks, &forces, moving);
+        let solved = solve_masses(&self.blocks, forces, moving);
         for (b, x) in self.blocks.iter_mut().zip(solved) {
             let Some(x) = x else {
                 continue;
