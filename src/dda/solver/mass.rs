@@ -9,7 +9,6 @@
 //! waiting on the last, now overlap (they were a tenth of the three-storey frame's time).
 
 use super::PerBlock;
-use super::per_block;
 use crate::dda::block::{Block, Mat6, Vec6};
 use crate::dda::linear::DenseCholesky;
 use crate::dda::mat6::factorable;
@@ -18,15 +17,30 @@ use crate::dda::mat6::factorable;
 /// x86-64 build (one vector where AVX is enabled), whose chains overlap.
 const LANES: usize = 4;
 
-/// M⁻¹ f of every block for which `wanted` holds (`None` for the others, and for a
-/// block whose mass matrix is not positive definite), each the same, to the bit, as
-/// [`solve_mass`] of that block alone.
+/// [`solve_masses_into`], returned (the tests' form).
+#[cfg(test)]
 pub(super) fn solve_masses(
     blocks: &[Block],
     forces: &[Vec6],
     wanted: impl Fn(&Block) -> bool,
 ) -> PerBlock<Option<Vec6>> {
-    let mut out: PerBlock<Option<Vec6>> = per_block(blocks.len(), |_| None);
+    let mut out = PerBlock::new();
+    solve_masses_into(blocks, forces, wanted, &mut out);
+    out
+}
+
+/// M⁻¹ f of every block for which `wanted` holds (`None` for the others, and for a
+/// block whose mass matrix is not positive definite), each the same, to the bit, as
+/// [`solve_mass`] of that block alone, written into `out` (filled in place: returned, a
+/// two-block step's solutions were copied twice).
+pub(super) fn solve_masses_into(
+    blocks: &[Block],
+    forces: &[Vec6],
+    wanted: impl Fn(&Block) -> bool,
+    out: &mut PerBlock<Option<Vec6>>,
+) {
+    out.clear();
+    out.resize(blocks.len(), None);
     // Deformable blocks of the usual mass matrix go in lanes; the rest one by one.
     let mut lanes: PerBlock<usize> = PerBlock::new();
     for (i, b) in blocks.iter().enumerate().filter(|(_, b)| wanted(b)) {
@@ -56,7 +70,6 @@ pub(super) fn solve_masses(
             }
         }
     }
-    out
 }
 
 /// Whether the translations' rows and columns of `m` are zero but for their diagonal (a
@@ -78,20 +91,23 @@ fn solve_translation(m: &Mat6, f: &Vec6, i: usize) -> Option<f64> {
     Some(f[i] / root / root)
 }
 
-/// The factor of M's unknowns `from..from + N`, holding those from `moving` on (a rigid
-/// block's strains: the identity's rows in the factor). `None` if not positive definite.
-fn held_factor<const N: usize>(m: &Mat6, from: usize, moving: usize) -> Option<DenseCholesky<N>> {
+/// Makes `factor` the factor of M's unknowns `from..from + N`, holding those from
+/// `moving` on (a rigid block's strains: the identity's rows in the factor). False if not
+/// positive definite. (Written into the caller's factor: returned, it was copied.)
+fn held_factor<const N: usize>(
+    m: &Mat6,
+    from: usize,
+    moving: usize,
+    factor: &mut DenseCholesky<N>,
+) -> bool {
     let n = moving - from;
-    let mut factor = DenseCholesky::<N>::empty();
     for j in 0..N {
         factor.set(j, j, if j < n { m[from + j][from + j] } else { 1.0 });
         for i in j + 1..n {
             factor.set(i, j, m[from + i][from + j]);
         }
     }
-    factor
-        .factorize_holding(std::array::from_fn(|j| j >= n))
-        .then_some(factor)
+    factor.factorize_holding(std::array::from_fn(|j| j >= n))
 }
 
 /// [`solve_mass`] of `L` deformable blocks whose translations are uncoupled, lane by
@@ -182,13 +198,17 @@ pub(super) fn solve_mass(b: &Block, f: &Vec6) -> Option<Vec6> {
     if !translations_uncoupled(m) {
         return solve_mass_coupled(b, f);
     }
-    let mut x = [0.0; 6];
+    let moving = b.moving_unknowns();
+    // The moving unknowns' forces, zero for the held ones (a copy of a length known only
+    // at run time would call `memcpy`, for a few bytes).
+    let mut x: Vec6 = std::array::from_fn(|i| if i < moving { f[i] } else { 0.0 });
     for i in 0..2 {
         x[i] = solve_translation(m, f, i)?;
     }
-    let moving = b.moving_unknowns();
-    let rest = held_factor::<4>(m, 2, moving)?;
-    x[2..moving].copy_from_slice(&f[2..moving]);
+    let mut rest = DenseCholesky::<4>::empty();
+    if !held_factor(m, 2, moving, &mut rest) {
+        return None;
+    }
     rest.solve(&mut x[2..]);
     Some(x)
 }
@@ -197,7 +217,10 @@ pub(super) fn solve_mass(b: &Block, f: &Vec6) -> Option<Vec6> {
 /// makes): one 6 × 6 factor.
 fn solve_mass_coupled(b: &Block, f: &Vec6) -> Option<Vec6> {
     let moving = b.moving_unknowns();
-    let mass = held_factor::<6>(&b.mass, 0, moving)?;
+    let mut mass = DenseCholesky::<6>::empty();
+    if !held_factor(&b.mass, 0, moving, &mut mass) {
+        return None;
+    }
     let mut x = [0.0; 6];
     x[..moving].copy_from_slice(&f[..moving]);
     mass.solve(&mut x);

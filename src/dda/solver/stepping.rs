@@ -1,7 +1,7 @@
 //! The step controller: Δt cuts, event landing, integrator restarts, and the commit of a converged step (integrator update, energy booking, geometry).
 
 use super::iteration::yield_stretch;
-use super::mass::{solve_mass, solve_masses};
+use super::mass::{solve_mass, solve_masses_into};
 use super::*;
 
 impl Dda {
@@ -922,8 +922,9 @@ impl Dda {
         }
         let forces = after;
         let moving = |b: &Block| b.role != BlockRole::PrescribedGround;
-        let solved = solve_masses(&self.blocks, forces, moving);
-        for (b, x) in self.blocks.iter_mut().zip(solved) {
+        let mut solved = PerBlock::new();
+        solve_masses_into(&self.blocks, forces, moving, &mut solved);
+        for (b, x) in self.blocks.iter_mut().zip(&solved) {
             let Some(x) = x else {
                 continue;
             };
