@@ -87,7 +87,8 @@ impl Dda {
     pub(super) fn settle_with(&mut self, friction: Option<f64>) -> Result<f64> {
         let known = vec![[0.0; 6]; self.blocks.len()];
         self.detect_contacts();
-        let Ok((increments, _)) = self.iterate(Mode::Static { friction }, &known)? else {
+        let mut increments = PerBlock::new();
+        let Ok(_) = self.iterate(Mode::Static { friction }, &known, &mut increments)? else {
             return Err(Error::Solver {
                 time: 0.0,
                 reason:

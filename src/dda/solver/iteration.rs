@@ -24,13 +24,20 @@ pub(super) enum Unsettled {
     FrictionChanging,
 }
 
-/// The outcome of an open-close iteration: the increments of all blocks and the number of
-/// passes, or what kept it from settling.
-pub(super) type Settled = std::result::Result<(PerBlock<Vec6>, usize), Unsettled>;
+/// The outcome of an open-close iteration: the number of passes (the increments of all
+/// blocks are in the caller's vector), or what kept it from settling.
+pub(super) type Settled = std::result::Result<usize, Unsettled>;
 
 impl Dda {
-    /// Runs the open-close iteration (see [`Settled`]).
-    pub(super) fn iterate(&mut self, mode: Mode, known: &[Vec6]) -> Result<Settled> {
+    /// Runs the open-close iteration (see [`Settled`]); the last pass's increments of all
+    /// blocks are left in `increments` (filled in place: handed back by value, they were
+    /// copied at every level of the call).
+    pub(super) fn iterate(
+        &mut self,
+        mode: Mode,
+        known: &[Vec6],
+        increments: &mut PerBlock<Vec6>,
+    ) -> Result<Settled> {
         self.refresh_element_terms();
         let elements = std::mem::take(&mut self.elements);
         let mut base = self
@@ -39,7 +46,7 @@ impl Dda {
             .unwrap_or_else(|| System::zeros(Arc::clone(&self.pattern), 1.0));
         self.assemble_base_into(&mut base, mode, known, &elements);
         self.elements = elements;
-        let result = self.open_close(mode, known, &base);
+        let result = self.open_close(mode, known, &base, increments);
         self.base_system = Some(base);
         result
     }
@@ -60,6 +67,7 @@ impl Dda {
         mode: Mode,
         known: &[Vec6],
         base: &System,
+        increments: &mut PerBlock<Vec6>,
     ) -> Result<Settled> {
         let open_tolerance = self.open_tolerance();
         let slip_tolerance = 1e-12 * self.structure_size;
@@ -75,7 +83,6 @@ impl Dda {
         // (a tenth of its time went to such copies).
         let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::new();
         solution.resize(self.dofs.n, 0.0);
-        let mut increments: PerBlock<Vec6> = PerBlock::new();
         let mut velocities: PerBlock<Vec6> = PerBlock::new();
         let mut unsettled = Unsettled::StatesChanging;
         // In a dynamic step's last quarter of the passes (at least its last pass) a contact
@@ -85,9 +92,9 @@ impl Dda {
         for pass in 1..=max_passes {
             let holding_stick_slip =
                 pass >= holds_stick_slip_from && matches!(mode, Mode::Dynamic { .. });
-            self.solve_pass(mode, known, base, &mut solution, &mut increments)?;
+            self.solve_pass(mode, known, base, &mut solution, increments)?;
             match mode {
-                Mode::Dynamic { dt } => self.end_velocities_into(&increments, dt, &mut velocities),
+                Mode::Dynamic { dt } => self.end_velocities_into(increments, dt, &mut velocities),
                 Mode::Static { .. } | Mode::Modal => {
                     velocities.clear();
                     velocities.resize(self.blocks.len(), [0.0; 6]);
@@ -290,7 +297,7 @@ impl Dda {
                 return Ok(Err(Unsettled::Contradicted));
             }
             if !states_changed && !friction_changed {
-                return Ok(Ok((increments, pass)));
+                return Ok(Ok(pass));
             }
             unsettled = if states_changed {
                 Unsettled::StatesChanging

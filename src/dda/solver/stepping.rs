@@ -204,6 +204,8 @@ impl Dda {
         // The start state before contacts were released (see `release_opening_contacts`),
         // and the step size they were released for.
         let mut release: Option<(f64, Released)> = None;
+        // The open-close iteration's increments, filled in place by each attempt.
+        let mut increments: PerBlock<Vec6> = PerBlock::new();
         loop {
             let dt = step_size(dt_override.unwrap_or(self.dt_current), max_dt);
             if let Some((_, before)) = release.take_if(|(at, _)| *at != dt) {
@@ -216,7 +218,7 @@ impl Dda {
             self.stiffen_constraints_for(dt);
             self.predict_friction_normals(dt);
             self.follow_curvature(dt);
-            let outcome = self.iterate(mode, &known)?;
+            let outcome = self.iterate(mode, &known, &mut increments)?;
             // A loaded contact that opens: the chosen scheme would apply half its start
             // force while the vertex moves off, a push the contact cannot give (a toppling
             // block's two corners, holding 1.2e7 N after an impact, threw it up with 1.6 kJ
@@ -340,7 +342,7 @@ impl Dda {
             }
             let reason = match outcome {
                 Err(why) => self.count_unsettled(why),
-                Ok((increments, passes)) => {
+                Ok(passes) => {
                     let ratio = self.max_relative_displacement(&increments, &known);
                     if ratio <= self.params.max_displacement_ratio {
                         let report = self.commit_step(
