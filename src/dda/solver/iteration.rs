@@ -508,13 +508,18 @@ impl Dda {
     fn end_velocities_into(&self, increments: &[Vec6], dt: f64, out: &mut PerBlock<Vec6>) {
         let c = &self.coeffs;
         out.clear();
-        out.extend(self.blocks.iter().zip(increments).map(|(b, d)| match b.role {
-            BlockRole::PrescribedGround => [0.0; 6],
-            _ => std::array::from_fn(|k| {
-                let a_new = c.end_accel(d[k], b.velocity[k], b.accel[k], dt);
-                c.end_velocity(b.velocity[k], b.accel[k], a_new, dt)
-            }),
-        }));
+        out.extend(
+            self.blocks
+                .iter()
+                .zip(increments)
+                .map(|(b, d)| match b.role {
+                    BlockRole::PrescribedGround => [0.0; 6],
+                    _ => std::array::from_fn(|k| {
+                        let a_new = c.end_accel(d[k], b.velocity[k], b.accel[k], dt);
+                        c.end_velocity(b.velocity[k], b.accel[k], a_new, dt)
+                    }),
+                }),
+        );
     }
 
     /// Increments of all blocks from the solution vector and the known ones.
@@ -527,10 +532,16 @@ impl Dda {
     /// [`Dda::increments`] into `out`.
     fn increments_into(&self, solution: &[f64], known: &[Vec6], out: &mut PerBlock<Vec6>) {
         out.clear();
-        out.extend(self.dofs.slot.iter().zip(known).map(|(slot, known)| match *slot {
-            Some(s) => std::array::from_fn(|k| solution[s + k]),
-            None => *known,
-        }));
+        out.extend(
+            self.dofs
+                .slot
+                .iter()
+                .zip(known)
+                .map(|(slot, known)| match *slot {
+                    Some(s) => std::array::from_fn(|k| solution[s + k]),
+                    None => *known,
+                }),
+        );
     }
 }
 
