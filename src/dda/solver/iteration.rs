@@ -80,7 +80,7 @@ impl Dda {
         // Inline for the systems the linear solver factorises on the stack. These and the
         // per-block vectors below are filled in place at every pass: a two-block step's
         // vectors are ~200 bytes each, and handing them out by value copied each one
-        // (a tenth of its time went to such copies).
+        // (with the step's other such copies, 7–10 % of its time).
         let mut solution: SmallVec<[f64; TINY_LIMIT]> = SmallVec::new();
         solution.resize(self.dofs.n, 0.0);
         let mut velocities: PerBlock<Vec6> = PerBlock::new();
