@@ -869,6 +869,14 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
 /// before anything is run (and in a build without the window too).
 fn check_picture(args: &RenderArgs) -> Result<()> {
     use slidebase::limits::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
+    // The name says what is written: a name of another kind would get a PNG's bytes.
+    let extension = args.out.extension().and_then(|e| e.to_str());
+    if !extension.is_some_and(|e| ["png", "mp4", "gif"].contains(&e.to_lowercase().as_str())) {
+        bail!(
+            "invalid --out: {}: give a .png (a picture), or an .mp4 or .gif (a replay)",
+            args.out.display()
+        );
+    }
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
         if let Some(v) = v
             && !(MIN_IMAGE_SIDE..=MAX_IMAGE_SIDE).contains(&v)

@@ -125,6 +125,15 @@ pub fn render_picture(
 ) -> Result<ExportInfo> {
     crate::error::require_non_negative("--time", time)?;
     check_options(options)?;
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(Error::invalid(
+            "--out",
+            format!("{}: a picture is written as .png", path.display()),
+        ));
+    }
     // The run is checked (and computed) before the graphics adapter is looked for, so that
     // a bad flag is reported as such on any machine.
     let t0 = std::time::Instant::now();

@@ -443,3 +443,22 @@ fn a_vertical_record_is_named_in_the_summary() {
         );
     }
 }
+
+/// `render` refuses an output name that is neither a picture (.png) nor a replay (.mp4,
+/// .gif) before it computes anything: a `.txt` got a PNG's bytes.
+#[test]
+fn render_refuses_an_output_name_it_would_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["picture.txt", "picture"] {
+        let path = dir.path().join(name);
+        let out = slidebase(&["render", "--out", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name}: {err}");
+        assert!(
+            err.contains("--out") && err.contains(".png") && err.contains(".mp4"),
+            "{name}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{name}: {err}");
+        assert!(!path.exists(), "{name} was written");
+    }
+}
