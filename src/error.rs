@@ -134,6 +134,18 @@ impl Error {
         }
     }
 
+    /// A file named where a built-in name or a file is accepted that does not exist, as
+    /// an [`Error::Io`] that also lists the built-in `kind`s (`builtins`).
+    pub fn missing_file(kind: &str, name: &str, builtins: &str) -> Self {
+        Error::io(
+            name,
+            std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("no such {kind} file (the built-in {kind}s: {builtins})"),
+            ),
+        )
+    }
+
     /// Shorthand for [`Error::Io`].
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
@@ -198,4 +210,12 @@ pub fn require_range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> R
             ),
         ))
     }
+}
+
+/// Whether `name`, given where a built-in name or a file path is accepted, was meant as a
+/// path: it has an extension or a folder. For such a name a missing file is the error to
+/// report, not an unknown built-in.
+pub fn meant_as_path(name: &str) -> bool {
+    let path = std::path::Path::new(name);
+    path.extension().is_some() || path.parent().is_some_and(|p| !p.as_os_str().is_empty())
 }

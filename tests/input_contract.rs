@@ -945,3 +945,26 @@ fn an_absurd_duration_is_refused_in_a_readable_line() {
     assert_has(&e, &["1.000e303 steps", "9.3e293 h", "--confirm-large"]);
     assert!(e.len() < 400, "{} characters: {e}", e.len());
 }
+
+/// A scene or record named by a path that does not exist is reported as a missing file,
+/// with the built-in names: it read as an unknown built-in called '/tmp/…/none.toml'.
+#[test]
+fn a_missing_scene_or_record_file_is_named_as_missing() {
+    let dir = std::env::temp_dir().join("slidebase-no-such-folder");
+    let scene = dir.join("none.toml");
+    let e = resolve_scene(scene.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert_has(
+        &e,
+        &["none.toml", "no such scene file", "three-storey", "wall:N"],
+    );
+    let record = dir.join("none.csv");
+    let e = slidebase::ground_motion::resolve_record(record.to_str().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert_has(&e, &["none.csv", "no such record file", "el-centro"]);
+    // A bare name is still an unknown built-in.
+    let e = resolve_scene("no-such-scene").unwrap_err().to_string();
+    assert_has(&e, &["unknown scene 'no-such-scene'"]);
+}

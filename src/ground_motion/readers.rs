@@ -427,6 +427,10 @@ pub fn resolve_record(name_or_path: &str) -> Result<Record> {
     if path.exists() {
         return read_record_file(path);
     }
+    if crate::error::meant_as_path(name_or_path) {
+        let builtins = builtin_names().join(", ");
+        return Err(Error::missing_file("record", name_or_path, &builtins));
+    }
     Err(Error::Unknown {
         kind: "record",
         name: name_or_path.to_string(),

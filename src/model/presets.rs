@@ -38,13 +38,17 @@ pub fn resolve_scene(name_or_path: &str) -> Result<Scene> {
     if path.exists() {
         return Scene::load(path);
     }
+    let known = format!(
+        "{}, frame:N, wall:N, friction-pendulum[:R]",
+        builtin_names().join(", ")
+    );
+    if crate::error::meant_as_path(name_or_path) {
+        return Err(Error::missing_file("scene", name_or_path, &known));
+    }
     Err(Error::Unknown {
         kind: "scene",
         name: name_or_path.to_string(),
-        known: format!(
-            "{}, frame:N, wall:N, friction-pendulum[:R]",
-            builtin_names().join(", ")
-        ),
+        known,
     })
 }
 
