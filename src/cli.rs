@@ -865,18 +865,12 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     ))
 }
 
-/// The picture flags of `render` in their ranges (a 10⁵ × 10⁵ picture is 40 GB), checked
-/// before anything is run (and in a build without the window too).
-fn check_picture(args: &RenderArgs) -> Result<()> {
+/// The picture flags of `render` in their ranges (a 10⁵ × 10⁵ picture is 40 GB) and what
+/// its `--out` asks for (a picture, or a replay's format), checked before anything is run
+/// (and in a build without the window too).
+fn check_picture(args: &RenderArgs) -> Result<Option<slidebase::post::output::VideoFormat>> {
     use slidebase::limits::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
-    // The name says what is written: a name of another kind would get a PNG's bytes.
-    let extension = args.out.extension().and_then(|e| e.to_str());
-    if !extension.is_some_and(|e| ["png", "mp4", "gif"].contains(&e.to_lowercase().as_str())) {
-        bail!(
-            "invalid --out: {}: give a .png (a picture), or an .mp4 or .gif (a replay)",
-            args.out.display()
-        );
-    }
+    let video = slidebase::post::output::render_target(&args.out)?;
     for (flag, v) in [("--width", args.width), ("--height", args.height)] {
         if let Some(v) = v
             && !(MIN_IMAGE_SIDE..=MAX_IMAGE_SIDE).contains(&v)
@@ -889,14 +883,14 @@ fn check_picture(args: &RenderArgs) -> Result<()> {
     {
         bail!("invalid --exaggeration: {f}; give a finite factor > 0 (1: true scale)");
     }
-    Ok(())
+    Ok(video)
 }
 
 #[cfg(feature = "gui")]
 fn cmd_render(args: RenderArgs) -> Result<()> {
     use slidebase::export::{PictureOptions, VideoFormat, render_picture, render_video};
     use slidebase::sim::{Excitation, SimConfig};
-    check_picture(&args)?;
+    let video = check_picture(&args)?;
     let config = SimConfig {
         scene: args.scene,
         friction: args.friction,
@@ -906,7 +900,6 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         pga_g: args.pga,
         ..SimConfig::default()
     };
-    let video = VideoFormat::of(&args.out);
     let default_size = match video {
         Some(VideoFormat::Gif) => (800, 450),
         _ => (1280, 720),

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use crate::limits::{MAX_IMAGE_SIDE, MIN_IMAGE_SIDE};
+pub use crate::post::output::VideoFormat;
+use crate::post::output::render_target;
 use crate::render::offscreen::{Gpu, OffscreenUi, write_png};
 use crate::sim::{SimConfig, run_to_messages};
 use crate::ui::{AppState, Exaggeration, PlotData, scene::draw_scene};
@@ -125,10 +127,7 @@ pub fn render_picture(
 ) -> Result<ExportInfo> {
     crate::error::require_non_negative("--time", time)?;
     check_options(options)?;
-    if !path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-    {
+    if render_target(path)?.is_some() {
         return Err(Error::invalid(
             "--out",
             format!("{}: a picture is written as .png", path.display()),
@@ -168,31 +167,6 @@ pub fn write_data(state: &AppState, dir: &Path) -> Result<Vec<PathBuf>> {
     );
     crate::ui::write_plot_data(dir, &state.timeline, &data)?;
     Ok(vec![dir.join("series.csv"), dir.join("spectrum.csv")])
-}
-
-/// The video formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum VideoFormat {
-    /// H.264 in MP4, through ffmpeg.
-    Mp4,
-    /// Animated GIF.
-    Gif,
-}
-
-impl VideoFormat {
-    /// The format a file name asks for, or None for a picture.
-    pub fn of(path: &Path) -> Option<Self> {
-        match path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_lowercase)
-            .as_deref()
-        {
-            Some("mp4") => Some(Self::Mp4),
-            Some("gif") => Some(Self::Gif),
-            _ => None,
-        }
-    }
 }
 
 /// Whether `ffmpeg` can be run.
@@ -242,7 +216,7 @@ pub fn render_video(
 ) -> Result<ExportInfo> {
     check_options(options)?;
     let times = frame_times(from, to, fps)?;
-    let Some(mut format) = VideoFormat::of(path) else {
+    let Some(mut format) = render_target(path)? else {
         return Err(Error::invalid(
             "--out",
             format!("{}: a video is .mp4 or .gif", path.display()),

@@ -1,7 +1,8 @@
 //! Output folders written all or nothing: the folder is checked before the long work
 //! starts, every file is written under a temporary name beside its final one, and only
 //! when all of them are written are they renamed into place. A run that fails half-way
-//! leaves the previous outputs as they were, never a mixture.
+//! leaves the previous outputs as they were, never a mixture. And what a rendered
+//! output's name asks for ([`render_target`]).
 
 use std::path::{Path, PathBuf};
 
@@ -23,6 +24,38 @@ pub fn prepare_dir(dir: &Path) -> Result<()> {
         .map_err(|e| Error::output(dir, format!("cannot write into the folder: {e}")))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
+}
+
+/// The video formats a replay is written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VideoFormat {
+    /// H.264 in MP4, through ffmpeg.
+    Mp4,
+    /// Animated GIF.
+    Gif,
+}
+
+/// What `render --out path` writes, by the name's extension (any case): a picture
+/// (`None`) for `.png`, a replay in a [`VideoFormat`] for `.mp4` or `.gif`. Any other
+/// name is refused before anything is computed: it would get a PNG's bytes. (Checked
+/// here, outside the renderer, so that a build without the window refuses it too.)
+pub fn render_target(path: &Path) -> Result<Option<VideoFormat>> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_lowercase);
+    match extension.as_deref() {
+        Some("png") => Ok(None),
+        Some("mp4") => Ok(Some(VideoFormat::Mp4)),
+        Some("gif") => Ok(Some(VideoFormat::Gif)),
+        _ => Err(Error::invalid(
+            "--out",
+            format!(
+                "{}: give a .png (a picture), or an .mp4 or .gif (a replay)",
+                path.display()
+            ),
+        )),
+    }
 }
 
 /// A set of files being written into one folder.
