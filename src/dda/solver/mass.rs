@@ -91,6 +91,13 @@ fn solve_translation(m: &Mat6, f: &Vec6, i: usize) -> Option<f64> {
     Some(f[i] / root / root)
 }
 
+/// The forces `f` on the first `moving` unknowns, zero on the held ones (the right-hand
+/// side a held factor solves). Picked one by one: a copy of a length known only at run
+/// time would call `memcpy`, for a few bytes.
+fn moving_forces(f: &Vec6, moving: usize) -> Vec6 {
+    std::array::from_fn(|i| if i < moving { f[i] } else { 0.0 })
+}
+
 /// Makes `factor` the factor of M's unknowns `from..from + N`, holding those from
 /// `moving` on (a rigid block's strains: the identity's rows in the factor). False if not
 /// positive definite. (Written into the caller's factor: returned, it was copied.)
@@ -199,9 +206,7 @@ pub(super) fn solve_mass(b: &Block, f: &Vec6) -> Option<Vec6> {
         return solve_mass_coupled(b, f);
     }
     let moving = b.moving_unknowns();
-    // The moving unknowns' forces, zero for the held ones (a copy of a length known only
-    // at run time would call `memcpy`, for a few bytes).
-    let mut x: Vec6 = std::array::from_fn(|i| if i < moving { f[i] } else { 0.0 });
+    let mut x = moving_forces(f, moving);
     for i in 0..2 {
         x[i] = solve_translation(m, f, i)?;
     }
@@ -221,8 +226,7 @@ fn solve_mass_coupled(b: &Block, f: &Vec6) -> Option<Vec6> {
     if !held_factor(&b.mass, 0, moving, &mut mass) {
         return None;
     }
-    let mut x = [0.0; 6];
-    x[..moving].copy_from_slice(&f[..moving]);
+    let mut x = moving_forces(f, moving);
     mass.solve(&mut x);
     Some(x)
 }
