@@ -6,16 +6,13 @@
 //! surface the edge belongs to — the edge itself, or the circle of a dish whose chord it
 //! is ([`super::surface`]).
 
-use rustc_hash::FxHashMap;
-
 use super::block::{Block, EdgeFrame, Vec6};
 use super::judge::ContactState;
 use super::surface::{self, SurfaceFrame};
 use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::geometry::{Point, contains, cross, dot, sub};
 
-/// What the contacts of the last step remember, by key.
-pub type ContactMemories = FxHashMap<ContactKey, ContactMemory>;
+pub use super::memory::ContactMemories;
 
 /// Identifies a contact across steps: which vertex touches which edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -16,6 +16,7 @@ pub mod joints;
 pub mod judge;
 pub mod linear;
 pub mod mat6;
+pub mod memory;
 pub mod params;
 pub mod rayleigh;
 pub mod solver;

@@ -11,15 +11,18 @@ impl Dda {
             if c.state == c.start_state {
                 continue;
             }
-            let m = self.memory.entry(c.key).or_insert(ContactMemory {
-                state: c.start_state,
-                shear: 0.0,
-                normal_force: 0.0,
-                normal_change: 0.0,
-                shear_multiplier: 0.0,
-                shear_change: 0.0,
-                gap: c.gap0,
-            });
+            let m = self.memory.get_or_insert(
+                c.key,
+                ContactMemory {
+                    state: c.start_state,
+                    shear: 0.0,
+                    normal_force: 0.0,
+                    normal_change: 0.0,
+                    shear_multiplier: 0.0,
+                    shear_change: 0.0,
+                    gap: c.gap0,
+                },
+            );
             m.state = c.state;
             m.shear = 0.0;
             m.normal_change = 0.0;
