@@ -27,6 +27,23 @@ pub struct ContactKey {
     pub edge: usize,
 }
 
+#[cfg(test)]
+impl ContactMemory {
+    /// A stuck contact's memory with a unit normal force and no shear, at `gap` (a test
+    /// fixture).
+    pub(crate) fn stuck_for_test(gap: f64) -> Self {
+        Self {
+            state: ContactState::Locked,
+            shear: 0.0,
+            normal_force: 1.0,
+            normal_change: 0.0,
+            shear_multiplier: 0.0,
+            shear_change: 0.0,
+            gap,
+        }
+    }
+}
+
 /// Joint properties of a declared contact pair, resolved to numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointProps {
@@ -540,15 +557,7 @@ mod tests {
             edge_block: 0,
             edge,
         };
-        let closed = ContactMemory {
-            state: ContactState::Locked,
-            shear: 0.0,
-            normal_force: 1.0,
-            normal_change: 0.0,
-            shear_multiplier: 0.0,
-            shear_change: 0.0,
-            gap: 0.0,
-        };
+        let closed = ContactMemory::stuck_for_test(0.0);
         for (from, to) in [(2, 1), (2, 5), (1, 2), (5, 2)] {
             let mut memory = ContactMemories::default();
             memory.insert(key(from), closed);

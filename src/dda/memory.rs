@@ -101,18 +101,9 @@ impl ContactMemories {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dda::judge::ContactState;
 
     fn memory(gap: f64) -> ContactMemory {
-        ContactMemory {
-            state: ContactState::Locked,
-            shear: 0.0,
-            normal_force: 1.0,
-            normal_change: 0.0,
-            shear_multiplier: 0.0,
-            shear_change: 0.0,
-            gap,
-        }
+        ContactMemory::stuck_for_test(gap)
     }
 
     fn key(vertex_block: usize, vertex: usize, edge_block: usize, edge: usize) -> ContactKey {
