@@ -2,9 +2,9 @@
 //!
 //! Rebuilt at every committed step from the step's contacts and looked up by every
 //! vertex-edge candidate of the next detection, so its layout is a matter of speed on a
-//! large wall (~3 000 contacts a step): the memories sit in a vector in the order they
-//! were written — the order the next detection asks for them — and a hash table maps a
-//! compact key to a position. A table of the memories themselves (96-byte buckets) took
+//! large wall (wall:31: ~7 000 contacts a step): the memories sit in a vector in the
+//! order they were written — the order the next detection asks for them — and a hash
+//! table maps a compact key to a position. A table of the memories themselves (96-byte buckets) took
 //! a cache miss at nearly every write.
 
 use std::collections::hash_map::Entry;
