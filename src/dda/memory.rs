@@ -57,23 +57,29 @@ impl ContactMemories {
 
     /// Sets the memory of `key` (replacing any it had).
     pub fn insert(&mut self, key: ContactKey, memory: ContactMemory) {
-        match self.index.entry(compact(&key)) {
-            Entry::Occupied(at) => self.entries[*at.get() as usize] = memory,
-            Entry::Vacant(slot) => {
-                slot.insert(self.entries.len() as u32);
-                self.entries.push(memory);
-            }
+        let (at, added) = self.position_or_push(key, memory);
+        if !added {
+            self.entries[at] = memory;
         }
     }
 
     /// The memory of `key` to change, first set to `memory` if it had none.
     pub fn get_or_insert(&mut self, key: ContactKey, memory: ContactMemory) -> &mut ContactMemory {
-        let next = self.entries.len() as u32;
-        let at = *self.index.entry(compact(&key)).or_insert(next);
-        if at == next {
-            self.entries.push(memory);
+        let (at, _) = self.position_or_push(key, memory);
+        &mut self.entries[at]
+    }
+
+    /// Where the memory of `key` is, and whether it was just added there as `memory`
+    /// (one lookup of the table either way).
+    fn position_or_push(&mut self, key: ContactKey, memory: ContactMemory) -> (usize, bool) {
+        match self.index.entry(compact(&key)) {
+            Entry::Occupied(at) => (*at.get() as usize, false),
+            Entry::Vacant(slot) => {
+                slot.insert(self.entries.len() as u32);
+                self.entries.push(memory);
+                (self.entries.len() - 1, true)
+            }
         }
-        &mut self.entries[at as usize]
     }
 
     /// Forgets every memory (keeping the storage for the next step's).
