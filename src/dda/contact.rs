@@ -158,6 +158,10 @@ pub struct Contact {
     /// Curvature of the surface under the vertex, 1/m (0 on a flat edge; see
     /// [`SurfaceFrame::curvature`]).
     pub curvature: f64,
+    /// Where this contact's own memory was last seen in the contact memory: a hint for
+    /// [`ContactMemories::get_near`] (checked against the key there, so a stale one only
+    /// costs a lookup).
+    pub memory_slot: usize,
 }
 
 impl Contact {
@@ -247,6 +251,7 @@ pub fn detect(
     out: &mut Vec<Contact>,
 ) {
     out.clear();
+    let mut memory = InOrder { memory, next: 0 };
     for (pair_index, pair) in pairs.iter().enumerate() {
         let [a, b] = pair.blocks;
         let (alo, ahi) = aabb(&blocks[a].vertices);
@@ -259,9 +264,27 @@ pub fn detect(
             continue;
         }
         let first = out.len();
-        detect_one_way(blocks, a, b, pair_index, pair.props, memory, search, out);
+        detect_one_way(
+            blocks,
+            a,
+            b,
+            pair_index,
+            pair.props,
+            &mut memory,
+            search,
+            out,
+        );
         let split = out.len();
-        detect_one_way(blocks, b, a, pair_index, pair.props, memory, search, out);
+        detect_one_way(
+            blocks,
+            b,
+            a,
+            pair_index,
+            pair.props,
+            &mut memory,
+            search,
+            out,
+        );
         // A vertex of b that sits on a vertex of a already in contact would double the
         // same physical contact (vertex-vertex); keep the first one. Only this pair's
         // contacts are looked at, so the search stays linear in the number of pairs.
@@ -285,6 +308,29 @@ pub fn detect(
     }
 }
 
+/// A memory found, and its position in the contact memory.
+type Found<'a> = (usize, &'a ContactMemory);
+
+/// The contact memory read in the order it was written: the detection asks for the
+/// contacts of the last step in the order it found them then, so the next memory is
+/// looked for first where the last one found was followed.
+struct InOrder<'a> {
+    memory: &'a ContactMemories,
+    /// The position after the last memory found.
+    next: usize,
+}
+
+impl<'a> InOrder<'a> {
+    /// The memory of `key` and its position, if it has one.
+    fn get(&mut self, key: &ContactKey) -> Option<Found<'a>> {
+        let found = self.memory.get_near(key, self.next);
+        if let Some((at, _)) = found {
+            self.next = at + 1;
+        }
+        found
+    }
+}
+
 /// The edge a contact on edge `k` of `block` is known by: an arc's first edge for any of
 /// its chords (the contact is with the circle, and keeps its memory however many facets a
 /// step crosses: a slider at 1.4 m/s crosses more than one 1.4 mm facet per step), else
@@ -299,14 +345,16 @@ fn surface_edge(block: &Block, k: usize) -> usize {
 /// An arc's neighbours are the edges before its first chord and after its last (the arc
 /// is known by its first chord, so a vertex leaving it over its last end, or arriving
 /// there, would otherwise not find it).
+/// `hint`: where the key's own memory is expected (see [`ContactMemories::get_near`]).
 pub fn remembered(
     memory: &ContactMemories,
     key: ContactKey,
+    hint: usize,
     block: &Block,
 ) -> Option<ContactMemory> {
     memory
-        .get(&key)
-        .copied()
+        .get_near(&key, hint)
+        .map(|(_, m)| *m)
         .or_else(|| remembered_by_neighbour(memory, key, block))
 }
 
@@ -339,7 +387,7 @@ fn detect_one_way(
     eb: usize,
     pair: usize,
     props: JointProps,
-    memory: &ContactMemories,
+    memory: &mut InOrder,
     search: f64,
     out: &mut Vec<Contact>,
 ) {
@@ -365,7 +413,7 @@ fn detect_one_way(
             continue;
         }
         // Best candidate edge: smallest |gap|, preferring the edge this vertex touched last.
-        let mut best: Option<(ContactKey, f64, Option<&ContactMemory>)> = None;
+        let mut best: Option<(ContactKey, f64, Option<Found>)> = None;
         for ek in 0..ne {
             let p2 = eblock.vertices[ek];
             let EdgeFrame {
@@ -420,9 +468,11 @@ fn detect_one_way(
         let Some((key, _, own)) = best else { continue };
         // The candidates' lookups already found the key's own memory, if any.
         let mem = own
-            .copied()
-            .or_else(|| remembered_by_neighbour(memory, key, eblock));
-        out.push(linearise(vblock, eblock, key, pair, props, mem));
+            .map(|(_, m)| *m)
+            .or_else(|| remembered_by_neighbour(memory.memory, key, eblock));
+        let mut contact = linearise(vblock, eblock, key, pair, props, mem);
+        contact.memory_slot = own.map_or(usize::MAX, |(at, _)| at);
+        out.push(contact);
     }
 }
 
@@ -511,6 +561,7 @@ fn linearise(
         point: p1,
         tangent: t,
         curvature,
+        memory_slot: usize::MAX,
     }
 }
 
@@ -562,7 +613,7 @@ mod tests {
             let mut memory = ContactMemories::default();
             memory.insert(key(from), closed);
             assert_eq!(
-                remembered(&memory, key(to), &dish),
+                remembered(&memory, key(to), 0, &dish),
                 Some(closed),
                 "from edge {from} to edge {to}"
             );
@@ -570,7 +621,7 @@ mod tests {
         // Not from a surface two edges away.
         let mut memory = ContactMemories::default();
         memory.insert(key(6), closed);
-        assert_eq!(remembered(&memory, key(2), &dish), None);
+        assert_eq!(remembered(&memory, key(2), 0, &dish), None);
     }
 
     /// The linearised gap matches the exact gap after small motions of both blocks.

@@ -5,7 +5,9 @@
 //! large wall (wall:31: ~7 000 contacts a step): the memories sit in a vector in the
 //! order they were written — the order the next detection asks for them — and a hash
 //! table maps a compact key to a position. A table of the memories themselves (96-byte buckets) took
-//! a cache miss at nearly every write.
+//! a cache miss at nearly every write. The keys are kept in the same order too, so a
+//! caller that knows where a memory was ([`ContactMemories::get_near`]: the detection's
+//! next position, a contact's slot) finds it by one comparison instead of a hash.
 
 use std::collections::hash_map::Entry;
 
@@ -35,6 +37,8 @@ pub struct ContactMemories {
     index: FxHashMap<CompactKey, u32>,
     /// The memories, in the order they were first written.
     entries: Vec<ContactMemory>,
+    /// The key of each memory in `entries`, at the same position.
+    keys: Vec<CompactKey>,
 }
 
 impl ContactMemories {
@@ -42,6 +46,18 @@ impl ContactMemories {
     pub fn get(&self, key: &ContactKey) -> Option<&ContactMemory> {
         let &at = self.index.get(&compact(key))?;
         Some(&self.entries[at as usize])
+    }
+
+    /// The memory of `key` and its position, looked for first at position `hint` (where
+    /// the caller expects it: any value is safe, a wrong one costs the table's lookup).
+    pub fn get_near(&self, key: &ContactKey, hint: usize) -> Option<(usize, &ContactMemory)> {
+        let key = compact(key);
+        let at = if self.keys.get(hint) == Some(&key) {
+            hint
+        } else {
+            *self.index.get(&key)? as usize
+        };
+        Some((at, &self.entries[at]))
     }
 
     /// True if `key` has a memory.
@@ -55,12 +71,14 @@ impl ContactMemories {
         Some(&mut self.entries[at as usize])
     }
 
-    /// Sets the memory of `key` (replacing any it had).
-    pub fn insert(&mut self, key: ContactKey, memory: ContactMemory) {
+    /// Sets the memory of `key` (replacing any it had); returns its position (a hint for
+    /// [`ContactMemories::get_near`]).
+    pub fn insert(&mut self, key: ContactKey, memory: ContactMemory) -> usize {
         let (at, added) = self.position_or_push(key, memory);
         if !added {
             self.entries[at] = memory;
         }
+        at
     }
 
     /// The memory of `key` to change, first set to `memory` if it had none.
@@ -75,6 +93,7 @@ impl ContactMemories {
         match self.index.entry(compact(&key)) {
             Entry::Occupied(at) => (*at.get() as usize, false),
             Entry::Vacant(slot) => {
+                self.keys.push(*slot.key());
                 slot.insert(self.entries.len() as u32);
                 self.entries.push(memory);
                 (self.entries.len() - 1, true)
@@ -86,6 +105,7 @@ impl ContactMemories {
     pub fn clear(&mut self) {
         self.index.clear();
         self.entries.clear();
+        self.keys.clear();
     }
 
     /// Every memory, to change (in no particular order).
@@ -154,5 +174,38 @@ mod tests {
         assert_eq!(m.get(&keys[0]), None);
         assert_eq!(m.get_or_insert(keys[0], memory(2.0)).gap, 2.0);
         assert_eq!(m.len(), 1);
+    }
+
+    /// A hint is only a place to look first: the right one, a wrong one and one past
+    /// the end all find the key's memory (and its position, which `insert` returned);
+    /// a key without a memory is not found at any hint.
+    #[test]
+    fn a_hint_never_changes_what_is_found() {
+        let mut m = ContactMemories::default();
+        let keys = [key(1, 2, 3, 4), key(4, 3, 2, 1), key(0, 0, 1, 1)];
+        let slots: Vec<usize> = (0..keys.len())
+            .map(|i| m.insert(keys[i], memory(i as f64)))
+            .collect();
+        assert_eq!(slots, [0, 1, 2]);
+        assert_eq!(
+            m.insert(keys[1], memory(5.0)),
+            1,
+            "a rewrite keeps its position"
+        );
+        for (i, k) in keys.iter().enumerate() {
+            let gap = if i == 1 { 5.0 } else { i as f64 };
+            for hint in [slots[i], (slots[i] + 1) % keys.len(), usize::MAX] {
+                let (at, found) = m.get_near(k, hint).expect("a memory");
+                assert_eq!((at, found.gap), (slots[i], gap), "{k:?} at hint {hint}");
+            }
+        }
+        for hint in [0, 1, 2, usize::MAX] {
+            assert!(m.get_near(&key(9, 9, 9, 9), hint).is_none());
+        }
+        m.clear();
+        assert!(
+            m.get_near(&keys[0], 0).is_none(),
+            "cleared: the old positions are gone"
+        );
     }
 }

@@ -64,7 +64,7 @@ impl Dda {
         }
         self.memory.clear();
         let augmented = self.augmented();
-        for c in &self.contacts {
+        for c in &mut self.contacts {
             let di = &increments[c.key.vertex_block];
             let dj = &increments[c.key.edge_block];
             let gap = c.gap_end(di, dj);
@@ -106,7 +106,9 @@ impl Dda {
                     0.0,
                 )
             };
-            self.memory.insert(
+            // Written in the contacts' order: the position is the hint the step's later
+            // lookups (the ledger's) and the next detection find it by.
+            c.memory_slot = self.memory.insert(
                 c.key,
                 ContactMemory {
                     state: c.state,
@@ -891,8 +893,12 @@ impl Dda {
     /// lose its weight for a step at every facet it crossed.)
     fn add_contact_forces(&self, out: &mut [Vec6]) {
         for c in &self.contacts {
-            let Some(m) = contact::remembered(&self.memory, c.key, &self.blocks[c.key.edge_block])
-            else {
+            let Some(m) = contact::remembered(
+                &self.memory,
+                c.key,
+                c.memory_slot,
+                &self.blocks[c.key.edge_block],
+            ) else {
                 continue;
             };
             if !m.state.is_closed() {
