@@ -180,6 +180,32 @@ impl System {
         }
     }
 
+    /// The matrix parts of `N` scalar springs between the same two blocks `i` and `j`
+    /// (`(k, a, b)`: stiffness and the directions on each), added block by block: each
+    /// 6 × 6 block is found once for all of them, and each entry receives the springs in
+    /// the order given — the sums of `N` calls of [`System::add_scalar_spring_matrix`].
+    pub fn add_scalar_springs_matrix<const N: usize>(
+        &mut self,
+        dofs: &DofMap,
+        (i, j): (usize, usize),
+        springs: [(f64, &Vec6, &Vec6); N],
+    ) {
+        let c = springs.map(|(k, _, _)| self.stiffness_factor * k);
+        for (bp, p) in [(i, 0), (j, 1)] {
+            let Some(sp) = dofs.slot[bp] else { continue };
+            for (bq, q) in [(i, 0), (j, 1)] {
+                if let Some(sq) = dofs.slot[bq] {
+                    let side =
+                        |t: usize, s: usize| if s == 0 { springs[t].1 } else { springs[t].2 };
+                    let terms: [(&Vec6, &Vec6, f64); N] =
+                        std::array::from_fn(|t| (side(t, p), side(t, q), c[t]));
+                    let leading = (dofs.moving[bp], dofs.moving[bq]);
+                    self.k.add_outers_leading(sp / 6, sq / 6, terms, leading);
+                }
+            }
+        }
+    }
+
     /// Nodal element: nodes are points `x_k` of blocks `b_k`; the element has stiffness
     /// `ke` (2n×2n, row-major, on node displacements) and start-of-step force `fe` (2n).
     ///
@@ -355,4 +381,44 @@ impl NodesByBlock {
 /// Displacement of node `x` of block `b` given all blocks' increments.
 pub fn node_displacement(centroids: &[Point], increments: &[Vec6], b: usize, x: Point) -> Point {
     super::block::point_displacement(centroids[b], x, &increments[b])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A contact's two springs added in one pass over the blocks they join are the same
+    /// to the bit as added one after the other: between two free blocks (a rigid one,
+    /// whose leading part only is added, and a deformable one) either way round, and
+    /// against a prescribed block, with zero entries in the directions (rows skipped).
+    #[test]
+    fn springs_in_one_pass_are_the_springs_one_after_the_other() {
+        let pattern = Arc::new(BlockPattern::new(2, [(0, 1)]));
+        // Blocks 0 (rigid) and 1 (deformable) free, block 2 prescribed.
+        let dofs = DofMap::new(&[true, true, false], vec![3, 6, 6]);
+        let mut next = crate::dda::linear::tests::pseudo_random(5);
+        let mut direction = || -> Vec6 {
+            let mut v: Vec6 = std::array::from_fn(|_| next());
+            v[4] = 0.0;
+            v
+        };
+        let mut one_pass = System::zeros(Arc::clone(&pattern), 0.7);
+        let mut one_by_one = System::zeros(Arc::clone(&pattern), 0.7);
+        for (i, j) in [(0, 1), (1, 0), (1, 2), (2, 0)] {
+            let (a, b, c, d) = (direction(), direction(), direction(), direction());
+            let springs = [(1e9, &a, &b), (3e8, &c, &d)];
+            one_pass.add_scalar_springs_matrix(&dofs, (i, j), springs);
+            for (k, u, v) in springs {
+                one_by_one.add_scalar_spring_matrix(&dofs, k, (i, u), Some((j, v)));
+            }
+        }
+        let bits =
+            |s: &System| -> Vec<u64> { s.k.to_dense().iter().map(|v| v.to_bits()).collect() };
+        assert!(one_pass.k.to_dense().iter().all(|v| v.is_finite()));
+        assert!(
+            one_pass.k.to_dense()[(1, 7)] != 0.0,
+            "the coupling block was added"
+        );
+        assert_eq!(bits(&one_pass), bits(&one_by_one));
+    }
 }

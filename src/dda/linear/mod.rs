@@ -235,31 +235,46 @@ impl BlockMatrix {
         u: &[f64; 6],
         v: &[f64; 6],
         scale: f64,
+        leading: (usize, usize),
+    ) {
+        self.add_outers_leading(bi, bj, [(u, v, scale)], leading);
+    }
+
+    /// [`BlockMatrix::add_outer_leading`] for `N` products `scale · u vᵀ` on the same
+    /// block, found once: each entry receives them in the order given, so the sums are
+    /// those of `N` calls one after the other (a contact's normal and shear springs).
+    #[inline]
+    pub fn add_outers_leading<const N: usize>(
+        &mut self,
+        bi: usize,
+        bj: usize,
+        terms: [(&[f64; 6], &[f64; 6], f64); N],
         (rows, cols): (usize, usize),
     ) {
         // Sizes fixed at compile time: the deformable blocks' 6 × 6 loop stays unrolled.
-        fn add<const R: usize, const C: usize>(
+        fn add<const R: usize, const C: usize, const N: usize>(
             b: &mut Mat6,
-            u: &[f64; 6],
-            v: &[f64; 6],
-            scale: f64,
+            terms: &[(&[f64; 6], &[f64; 6], f64); N],
         ) {
             for r in 0..R {
-                let s = scale * u[r];
-                if s == 0.0 {
-                    continue;
-                }
-                for c in 0..C {
-                    b[r][c] += s * v[c];
+                // Term after term along the row: each entry still receives them in order.
+                for (u, v, scale) in terms {
+                    let s = scale * u[r];
+                    if s == 0.0 {
+                        continue;
+                    }
+                    for c in 0..C {
+                        b[r][c] += s * v[c];
+                    }
                 }
             }
         }
         if let Some(b) = self.upper_block(bi, bj) {
             match (rows, cols) {
-                (3, 3) => add::<3, 3>(b, u, v, scale),
-                (3, _) => add::<3, 6>(b, u, v, scale),
-                (_, 3) => add::<6, 3>(b, u, v, scale),
-                _ => add::<6, 6>(b, u, v, scale),
+                (3, 3) => add::<3, 3, N>(b, &terms),
+                (3, _) => add::<3, 6, N>(b, &terms),
+                (_, 3) => add::<6, 3, N>(b, &terms),
+                _ => add::<6, 6, N>(b, &terms),
             }
         }
     }
@@ -1056,7 +1071,7 @@ pub(super) mod tests {
     }
 
     /// Reproducible numbers in [−0.5, 0.5) (a linear congruential generator).
-    pub(super) fn pseudo_random(seed: u64) -> impl FnMut() -> f64 {
+    pub(crate) fn pseudo_random(seed: u64) -> impl FnMut() -> f64 {
         let mut s = seed;
         move || {
             s = s

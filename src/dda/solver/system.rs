@@ -146,31 +146,23 @@ impl Dda {
                 (0.0, 0.0)
             };
             // Every closed contact resists approach; what acts along it depends on the state.
-            if c.state.is_closed() {
-                let p = c.props.normal_penalty;
-                sys.add_scalar_spring(
-                    &self.dofs,
-                    known,
-                    p,
-                    p * c.gap0 - lambda_n,
-                    (i, &c.gap_i),
-                    Some((j, &c.gap_j)),
-                );
-            }
+            let p = c.props.normal_penalty;
+            let normal = (p, p * c.gap0 - lambda_n, &c.gap_i, &c.gap_j);
             match c.state {
                 ContactState::Open => {}
                 ContactState::Locked => {
                     let ps = c.props.shear_penalty;
-                    sys.add_scalar_spring(
-                        &self.dofs,
-                        known,
-                        ps,
-                        ps * c.shear0 - lambda_s,
-                        (i, &c.slip_i),
-                        Some((j, &c.slip_j)),
-                    );
+                    let shear = (ps, ps * c.shear0 - lambda_s, &c.slip_i, &c.slip_j);
+                    // Both springs' matrices in one pass over the pair's four blocks.
+                    for (k, f0, a, b) in [normal, shear] {
+                        sys.add_scalar_spring_rhs(&self.dofs, known, k, f0, (i, a), Some((j, b)));
+                    }
+                    let springs = [normal, shear].map(|(k, _, a, b)| (k, a, b));
+                    sys.add_scalar_springs_matrix(&self.dofs, (i, j), springs);
                 }
                 ContactState::Sliding { direction } => {
+                    let (k, f0, a, b) = normal;
+                    sys.add_scalar_spring(&self.dofs, known, k, f0, (i, a), Some((j, b)));
                     // Friction: −δρN along the slip direction on the vertex, +δρN on the edge;
                     // as generalised forces that is −δρN·(slip_i, slip_j).
                     let friction = match mode {
