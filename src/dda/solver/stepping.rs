@@ -108,7 +108,7 @@ impl Dda {
             };
             // Written in the contacts' order: the position is the hint the step's later
             // lookups (the ledger's) and the next detection find it by.
-            c.memory_slot = self.memory.insert(
+            let slot = self.memory.insert(
                 c.key,
                 ContactMemory {
                     state: c.state,
@@ -130,6 +130,8 @@ impl Dda {
                     gap,
                 },
             );
+            // (Positions fit in 32 bits: the memory indexes them so.)
+            c.memory_slot = slot as u32;
         }
         Ok(())
     }
@@ -896,7 +898,7 @@ impl Dda {
             let Some(m) = contact::remembered(
                 &self.memory,
                 c.key,
-                c.memory_slot,
+                c.memory_slot as usize,
                 &self.blocks[c.key.edge_block],
             ) else {
                 continue;
