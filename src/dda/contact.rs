@@ -266,28 +266,23 @@ pub fn detect(
         {
             continue;
         }
+        let mut one_way = |vertices: usize, edges: usize, out: &mut Vec<Contact>| {
+            let props = pair.props;
+            detect_one_way(
+                blocks,
+                vertices,
+                edges,
+                pair_index,
+                props,
+                &mut memory,
+                search,
+                out,
+            );
+        };
         let first = out.len();
-        detect_one_way(
-            blocks,
-            a,
-            b,
-            pair_index,
-            pair.props,
-            &mut memory,
-            search,
-            out,
-        );
+        one_way(a, b, out);
         let split = out.len();
-        detect_one_way(
-            blocks,
-            b,
-            a,
-            pair_index,
-            pair.props,
-            &mut memory,
-            search,
-            out,
-        );
+        one_way(b, a, out);
         // A vertex of b that sits on a vertex of a already in contact would double the
         // same physical contact (vertex-vertex); keep the first one. Only this pair's
         // contacts are looked at, so the search stays linear in the number of pairs.
