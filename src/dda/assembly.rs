@@ -167,16 +167,13 @@ impl System {
         (bi, a): (usize, &Vec6),
         other: Option<(usize, &Vec6)>,
     ) {
-        let c = self.stiffness_factor * k;
-        let parts: [Option<(usize, &Vec6)>; 2] = [Some((bi, a)), other];
-        for &(bp, vp) in parts.iter().flatten() {
-            let Some(sp) = dofs.slot[bp] else { continue };
-            for &(bq, vq) in parts.iter().flatten() {
-                if let Some(sq) = dofs.slot[bq] {
-                    let leading = (dofs.moving[bp], dofs.moving[bq]);
-                    self.k.add_outer_leading(sp / 6, sq / 6, vp, vq, c, leading);
-                }
-            }
+        if let Some((bj, b)) = other {
+            return self.add_scalar_springs_matrix(dofs, (bi, bj), [(k, a, b)]);
+        }
+        if let Some(s) = dofs.slot[bi] {
+            let leading = (dofs.moving[bi], dofs.moving[bi]);
+            let c = self.stiffness_factor * k;
+            self.k.add_outer_leading(s / 6, s / 6, a, a, c, leading);
         }
     }
 

@@ -267,13 +267,12 @@ pub fn detect(
             continue;
         }
         let mut one_way = |vertices: usize, edges: usize, out: &mut Vec<Contact>| {
-            let props = pair.props;
             detect_one_way(
                 blocks,
                 vertices,
                 edges,
                 pair_index,
-                props,
+                pair.props,
                 &mut memory,
                 search,
                 out,
