@@ -44,8 +44,7 @@ pub struct ContactMemories {
 impl ContactMemories {
     /// The memory of `key`, if it has one.
     pub fn get(&self, key: &ContactKey) -> Option<&ContactMemory> {
-        let &at = self.index.get(&compact(key))?;
-        Some(&self.entries[at as usize])
+        Some(&self.entries[self.position(&compact(key))?])
     }
 
     /// The memory of `key` and its position, looked for first at position `hint` (where
@@ -55,20 +54,25 @@ impl ContactMemories {
         let at = if self.keys.get(hint) == Some(&key) {
             hint
         } else {
-            *self.index.get(&key)? as usize
+            self.position(&key)?
         };
         Some((at, &self.entries[at]))
     }
 
     /// True if `key` has a memory.
     pub fn contains_key(&self, key: &ContactKey) -> bool {
-        self.index.contains_key(&compact(key))
+        self.position(&compact(key)).is_some()
     }
 
     /// The memory of `key` to change, if it has one.
     pub fn get_mut(&mut self, key: &ContactKey) -> Option<&mut ContactMemory> {
-        let &at = self.index.get(&compact(key))?;
-        Some(&mut self.entries[at as usize])
+        let at = self.position(&compact(key))?;
+        Some(&mut self.entries[at])
+    }
+
+    /// Where the memory of `key` is, by the table.
+    fn position(&self, key: &CompactKey) -> Option<usize> {
+        self.index.get(key).map(|&at| at as usize)
     }
 
     /// Sets the memory of `key` (replacing any it had); returns its position (a hint for
