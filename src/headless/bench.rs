@@ -16,7 +16,8 @@ use super::frame::run_frame;
 use super::run::run;
 use super::sweep::{SweepRequest, paper_ratios, parse_ratios, run_sweep};
 use crate::dda::{Dda, SolverParams};
-use crate::ground_motion::{GroundMotion, resolve_record};
+use crate::ground_motion::{GroundMotion, Record, resolve_record};
+use crate::model::Scene;
 use crate::model::presets::resolve_scene;
 use crate::post::output::Staged;
 use crate::post::plot::{Figure, LegendCorner, Series};
@@ -103,8 +104,10 @@ pub struct ScalingPoint {
     pub contacts: usize,
     /// Model set-up and static settling, s.
     pub setup_s: f64,
-    /// Steps timed.
+    /// Steps timed (in each run).
     pub steps: u64,
+    /// Runs of the window (see [`scaling_point`]); the times are their medians.
+    pub runs: usize,
     /// Mean wall time per step, ms.
     pub mean_step_ms: f64,
     /// Median wall time per step, ms.
@@ -210,18 +213,71 @@ fn three_storey(fixed_base: bool) -> Result<(f64, u64, f64)> {
     ))
 }
 
-/// One scaling point: the scene under El Centro for `window` seconds after settling.
+/// A scaling point is run again until its runs have lasted this long in all: a small
+/// wall's window is over in ~60 ms, and one slow stretch of this shared machine then
+/// decided its median (wall:5 read 0.196 ms a step in one bench and 0.120 ms in the
+/// next, which moved the fitted exponent by 0.07).
+const SCALING_MIN_TOTAL_S: f64 = 1.0;
+
+/// At most this many runs of a scaling point.
+const SCALING_MAX_RUNS: usize = 9;
+
+/// One timed run of a scaling point's window.
+struct WindowRun {
+    setup_s: f64,
+    total_s: f64,
+    mean_step_ms: f64,
+    median_step_ms: f64,
+}
+
+/// One scaling point: the scene under El Centro for `window` seconds after settling, run
+/// until [`SCALING_MIN_TOTAL_S`] have passed (at most [`SCALING_MAX_RUNS`] runs; every
+/// run takes the same steps), reported by the medians over the runs.
 pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
     let scene = resolve_scene(scene_name)?;
-    let record = resolve_record("el-centro")?;
-    let motion = GroundMotion::Record(Arc::new(record));
+    let record = Arc::new(resolve_record("el-centro")?);
+    let mut dda = None;
+    let mut runs = Vec::new();
+    let mut elapsed = 0.0;
+    while runs.is_empty() || (elapsed < SCALING_MIN_TOTAL_S && runs.len() < SCALING_MAX_RUNS) {
+        let (run, done) = time_window(&scene, &record, window)?;
+        elapsed += run.setup_s + run.total_s;
+        runs.push(run);
+        dda = Some(done);
+    }
+    let Some((dda, steps, factorizations)) = dda else {
+        unreachable!("at least one run");
+    };
+    let over_runs = |f: fn(&WindowRun) -> f64| median(runs.iter().map(f).collect());
+    Ok(ScalingPoint {
+        scene: scene_name.into(),
+        family: scene_name.split(':').next().unwrap_or("").into(),
+        blocks: dda.blocks().len(),
+        unknowns: dda.unknowns(),
+        contacts: dda.last_report().contacts,
+        setup_s: over_runs(|r| r.setup_s),
+        steps,
+        runs: runs.len(),
+        mean_step_ms: over_runs(|r| r.mean_step_ms),
+        median_step_ms: over_runs(|r| r.median_step_ms),
+        factorizations,
+    })
+}
+
+/// Sets the scene up, settles it and times each step of `window` seconds of `record`;
+/// also returns the model (for its size), the steps and the factorisations.
+fn time_window(
+    scene: &Scene,
+    record: &Arc<Record>,
+    window: f64,
+) -> Result<(WindowRun, (Dda, u64, u64))> {
     let setup = Instant::now();
     let mut dda = Dda::new(
-        &scene,
-        Some(motion),
+        scene,
+        Some(GroundMotion::Record(Arc::clone(record))),
         SolverParams {
             duration: window,
-            ..SolverParams::for_scene(&scene)
+            ..SolverParams::for_scene(scene)
         },
     )?;
     let setup_s = setup.elapsed().as_secs_f64();
@@ -234,21 +290,17 @@ pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
         step_times.push(now.duration_since(last).as_secs_f64());
         last = now;
     })?;
-    let total = start.elapsed().as_secs_f64();
+    let total_s = start.elapsed().as_secs_f64();
     let after = dda.counters();
     let steps = after.steps - before.steps;
-    Ok(ScalingPoint {
-        scene: scene_name.into(),
-        family: scene_name.split(':').next().unwrap_or("").into(),
-        blocks: dda.blocks().len(),
-        unknowns: dda.unknowns(),
-        contacts: dda.last_report().contacts,
+    let run = WindowRun {
         setup_s,
-        steps,
-        mean_step_ms: 1e3 * total / steps.max(1) as f64,
+        total_s,
+        mean_step_ms: 1e3 * total_s / steps.max(1) as f64,
         median_step_ms: 1e3 * median(step_times),
-        factorizations: after.factorizations - before.factorizations,
-    })
+    };
+    let factorizations = after.factorizations - before.factorizations;
+    Ok((run, (dda, steps, factorizations)))
 }
 
 /// Least-squares slope of log(y) against log(x) (the same fit as the observed order of
@@ -430,13 +482,14 @@ pub fn report_text(r: &BenchReport) -> String {
     if !r.scaling.is_empty() {
         let _ = writeln!(
             s,
-            "\n{:<10} {:>7} {:>9} {:>9} {:>9} {:>7} {:>13} {:>15} {:>7}",
+            "\n{:<10} {:>7} {:>9} {:>9} {:>9} {:>7} {:>5} {:>13} {:>15} {:>7}",
             "scene",
             "blocks",
             "unknowns",
             "contacts",
             "setup s",
             "steps",
+            "runs",
             "mean ms/step",
             "median ms/step",
             "factor."
@@ -444,13 +497,14 @@ pub fn report_text(r: &BenchReport) -> String {
         for p in &r.scaling {
             let _ = writeln!(
                 s,
-                "{:<10} {:>7} {:>9} {:>9} {:>9.3} {:>7} {:>13.3} {:>15.3} {:>7}",
+                "{:<10} {:>7} {:>9} {:>9} {:>9.3} {:>7} {:>5} {:>13.3} {:>15.3} {:>7}",
                 p.scene,
                 p.blocks,
                 p.unknowns,
                 p.contacts,
                 p.setup_s,
                 p.steps,
+                p.runs,
                 p.mean_step_ms,
                 p.median_step_ms,
                 p.factorizations
