@@ -228,6 +228,8 @@ struct WindowRun {
     total_s: f64,
     mean_step_ms: f64,
     median_step_ms: f64,
+    steps: u64,
+    factorizations: u64,
 }
 
 /// One scaling point: the scene under El Centro for `window` seconds after settling, run
@@ -236,18 +238,14 @@ struct WindowRun {
 pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
     let scene = resolve_scene(scene_name)?;
     let record = Arc::new(resolve_record("el-centro")?);
-    let mut dda = None;
-    let mut runs = Vec::new();
-    let mut elapsed = 0.0;
-    while runs.is_empty() || (elapsed < SCALING_MIN_TOTAL_S && runs.len() < SCALING_MAX_RUNS) {
-        let (run, done) = time_window(&scene, &record, window)?;
+    let (first, dda) = time_window(&scene, &record, window)?;
+    let mut elapsed = first.setup_s + first.total_s;
+    let mut runs = vec![first];
+    while elapsed < SCALING_MIN_TOTAL_S && runs.len() < SCALING_MAX_RUNS {
+        let (run, _) = time_window(&scene, &record, window)?;
         elapsed += run.setup_s + run.total_s;
         runs.push(run);
-        dda = Some(done);
     }
-    let Some((dda, steps, factorizations)) = dda else {
-        unreachable!("at least one run");
-    };
     let over_runs = |f: fn(&WindowRun) -> f64| median(runs.iter().map(f).collect());
     Ok(ScalingPoint {
         scene: scene_name.into(),
@@ -256,21 +254,17 @@ pub fn scaling_point(scene_name: &str, window: f64) -> Result<ScalingPoint> {
         unknowns: dda.unknowns(),
         contacts: dda.last_report().contacts,
         setup_s: over_runs(|r| r.setup_s),
-        steps,
+        steps: runs[0].steps,
         runs: runs.len(),
         mean_step_ms: over_runs(|r| r.mean_step_ms),
         median_step_ms: over_runs(|r| r.median_step_ms),
-        factorizations,
+        factorizations: runs[0].factorizations,
     })
 }
 
 /// Sets the scene up, settles it and times each step of `window` seconds of `record`;
-/// also returns the model (for its size), the steps and the factorisations.
-fn time_window(
-    scene: &Scene,
-    record: &Arc<Record>,
-    window: f64,
-) -> Result<(WindowRun, (Dda, u64, u64))> {
+/// also returns the model (for its size and last contacts).
+fn time_window(scene: &Scene, record: &Arc<Record>, window: f64) -> Result<(WindowRun, Dda)> {
     let setup = Instant::now();
     let mut dda = Dda::new(
         scene,
@@ -298,9 +292,10 @@ fn time_window(
         total_s,
         mean_step_ms: 1e3 * total_s / steps.max(1) as f64,
         median_step_ms: 1e3 * median(step_times),
+        steps,
+        factorizations: after.factorizations - before.factorizations,
     };
-    let factorizations = after.factorizations - before.factorizations;
-    Ok((run, (dda, steps, factorizations)))
+    Ok((run, dda))
 }
 
 /// Least-squares slope of log(y) against log(x) (the same fit as the observed order of
