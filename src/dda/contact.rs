@@ -168,6 +168,12 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// [`Contact::memory_slot`] as the position a lookup takes (`u32::MAX`, no memory
+    /// seen, is a position no memory has).
+    pub fn memory_hint(&self) -> usize {
+        self.memory_slot as usize
+    }
+
     /// Whether the contact started the step closed and carrying a force, and its trial
     /// state opens it.
     pub fn opens_under_load(&self) -> bool {

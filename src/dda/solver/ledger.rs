@@ -43,7 +43,7 @@ impl Dda {
         }
         // The memory holds exactly the contacts of the last step.
         for c in &self.contacts {
-            let Some((_, m)) = self.memory.get_near(&c.key, c.memory_slot as usize) else {
+            let Some((_, m)) = self.memory.get_near(&c.key, c.memory_hint()) else {
                 continue;
             };
             if !m.state.is_closed() {

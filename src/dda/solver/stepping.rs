@@ -898,7 +898,7 @@ impl Dda {
             let Some(m) = contact::remembered(
                 &self.memory,
                 c.key,
-                c.memory_slot as usize,
+                c.memory_hint(),
                 &self.blocks[c.key.edge_block],
             ) else {
                 continue;
