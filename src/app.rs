@@ -4,6 +4,7 @@
 //! thread (see [`crate::sim`]) and wakes the window when it posts frames. The scene is drawn
 //! by [`crate::render::Renderer`] through an egui paint callback (see [`crate::ui::scene`]).
 
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use crate::render::Renderer;
@@ -32,6 +33,61 @@ const COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(100);
 /// (docs/performance.md). Input still repaints at once, and the end of the run is shown
 /// at once (see [`Wake`]); only the computing run's own progress frames are paced.
 const SOFTWARE_COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(500);
+
+/// How much lower than the simulation the window's threads run where a software
+/// rasteriser draws the frames (a nice value, added to the process's).
+const SOFTWARE_WINDOW_NICENESS: i32 = 5;
+
+/// Wakes the window when the simulation posts, once the window exists (`window` holds its
+/// context and its pace of redraws while a run computes).
+fn window_waker(window: Arc<OnceLock<(egui::Context, Duration)>>) -> crate::sim::Waker {
+    Box::new(move |wake| {
+        if let Some((ctx, computing_interval)) = window.get() {
+            match wake {
+                Wake::Progress => ctx.request_repaint_after(*computing_interval),
+                // A finished run is shown at once, not at the computing pace.
+                Wake::RunEnded => ctx.request_repaint(),
+            }
+        }
+    })
+}
+
+/// Where the frames are drawn in software (Mesa's llvmpipe, a machine without a GPU),
+/// the window's thread lowers its priority by [`SOFTWARE_WINDOW_NICENESS`] just before
+/// it creates the device, so the rasteriser's threads, started from it, inherit the lower
+/// priority. A frame there costs ~75 ms of CPU on the cores the two models compute on;
+/// while a run computes the simulation then gets the larger share of both cores, and the
+/// window still draws (a nice value shares the CPU, it does not starve). With a GPU nothing
+/// changes. Linux only: there a nice value belongs to one thread (elsewhere
+/// setpriority(2) would lower the whole process, the simulation with it).
+fn software_frames_yield(
+    mut options: egui_wgpu::WgpuConfiguration,
+) -> egui_wgpu::WgpuConfiguration {
+    if let egui_wgpu::WgpuSetup::CreateNew(create) = &mut options.wgpu_setup {
+        let descriptor = create.device_descriptor.clone();
+        create.device_descriptor = Arc::new(move |adapter: &wgpu::Adapter| {
+            if adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+                lower_this_threads_priority(SOFTWARE_WINDOW_NICENESS);
+            }
+            descriptor(adapter)
+        });
+    }
+    options
+}
+
+/// Adds `niceness` to the calling thread's nice value (best effort: a refusal leaves the
+/// priority as it was).
+#[cfg(target_os = "linux")]
+fn lower_this_threads_priority(niceness: i32) {
+    use rustix::process::{getpriority_process, setpriority_process};
+    let thread = Some(rustix::thread::gettid());
+    if let Ok(nice) = getpriority_process(thread) {
+        let _ = setpriority_process(thread, nice + niceness);
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn lower_this_threads_priority(_niceness: i32) {}
 
 /// How often the window redraws while a run computes, for the adapter that draws it.
 fn computing_frame_interval(adapter: &wgpu::AdapterInfo) -> Duration {
@@ -69,16 +125,22 @@ pub fn run_app() -> Result<()> {
                 .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
         })
         .unwrap_or((1600.0, 900.0));
+    // The simulation's thread first, at the process's priority: the window's thread is
+    // lowered below it before it creates the device (see `software_frames_yield`), and
+    // threads inherit the priority of the thread that starts them.
+    let window: Arc<OnceLock<(egui::Context, Duration)>> = Arc::default();
+    let sim = SimHandle::spawn_with_waker(window_waker(window.clone()));
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("slidebase — sliding-base structures under earthquakes (DDA)")
             .with_inner_size([w, h]),
+        wgpu_options: software_frames_yield(eframe::NativeOptions::default().wgpu_options),
         ..Default::default()
     };
     eframe::run_native(
         "slidebase",
         options,
-        Box::new(|cc| {
+        Box::new(move |cc| {
             let render_state = cc.wgpu_render_state.as_ref().ok_or_else(|| {
                 Box::<dyn std::error::Error + Send + Sync>::from(
                     crate::render::offscreen::NO_ADAPTER_HELP,
@@ -93,12 +155,8 @@ pub fn run_app() -> Result<()> {
                     render_state.target_format,
                 ));
             let computing_interval = computing_frame_interval(&render_state.adapter.get_info());
-            let ctx = cc.egui_ctx.clone();
-            let sim = SimHandle::spawn_with_waker(Box::new(move |wake| match wake {
-                Wake::Progress => ctx.request_repaint_after(computing_interval),
-                // A finished run is shown at once, not at the computing pace.
-                Wake::RunEnded => ctx.request_repaint(),
-            }));
+            // The simulation wakes this window from now on.
+            let _ = window.set((cc.egui_ctx.clone(), computing_interval));
             let (shots_tx, shots_rx) = std::sync::mpsc::channel();
             Ok(Box::new(App {
                 state: AppState::default(),
