@@ -250,7 +250,7 @@ impl ConnectionGroup {
     fn nodes(&self, connections: &[Connection]) -> [(usize, Point); MAX_NODES] {
         std::array::from_fn(|k| {
             let (ci, node) = self.sources[k];
-            connections[ci].node_list()[node]
+            connections[ci].node(node)
         })
     }
 
@@ -594,6 +594,11 @@ impl Connection {
         terms.ke[..36].copy_from_slice(&ke);
         terms.fe[..6].copy_from_slice(&fe);
         terms
+    }
+
+    /// Node `k` (0, 1 or 2) as (block, current position).
+    pub fn node(&self, k: usize) -> (usize, Point) {
+        (self.blocks[k], self.nodes[k])
     }
 
     /// The nodes as (block, current position).
