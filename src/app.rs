@@ -3,6 +3,8 @@
 //! computed, or on input — so a paused window costs nothing. The simulation runs on its own
 //! thread (see [`crate::sim`]) and wakes the window when it posts frames. The scene is drawn
 //! by [`crate::render::Renderer`] through an egui paint callback (see [`crate::ui::scene`]).
+//! Where the frames are drawn in software the window's threads run below the
+//! simulation's (see `software_frames_yield`).
 
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
@@ -354,5 +356,56 @@ impl eframe::App for App {
 
     fn on_exit(&mut self) {
         self.sim.send(crate::sim::SimCommand::Quit);
+    }
+}
+
+#[cfg(all(test, target_os = "linux"))]
+mod tests {
+    use super::*;
+    use rustix::process::getpriority_process;
+
+    /// The window lowers its own thread only: the simulation's thread, started before it,
+    /// and the process's other threads keep their priority (a nice value is per thread on
+    /// Linux), while a thread started after it inherits the lower one (llvmpipe's).
+    #[test]
+    fn lowering_the_window_thread_leaves_the_simulation_thread_alone() {
+        fn nice(thread: rustix::thread::Pid) -> i32 {
+            getpriority_process(Some(thread)).expect("getpriority")
+        }
+        let (tid_tx, tid_rx) = std::sync::mpsc::channel();
+        let (go_tx, go_rx) = std::sync::mpsc::channel::<()>();
+        // The "simulation": started first, it reports its thread and waits.
+        let simulation = std::thread::spawn(move || {
+            tid_tx.send(rustix::thread::gettid()).unwrap();
+            go_rx.recv().ok();
+        });
+        let simulation_tid = tid_rx.recv().unwrap();
+        let before = nice(simulation_tid);
+        // The "window".
+        let window = std::thread::spawn(move || {
+            let own = rustix::thread::gettid();
+            let start = nice(own);
+            lower_this_threads_priority(SOFTWARE_WINDOW_NICENESS);
+            // A rasteriser's thread, started by the window after it lowered itself.
+            let started = std::thread::spawn(|| nice(rustix::thread::gettid()))
+                .join()
+                .unwrap();
+            (start, nice(own), started)
+        });
+        let (start, lowered, started) = window.join().unwrap();
+        // Nice values stop at 19: a test run under `nice -n 19` has nothing to lower.
+        let expected = (start + SOFTWARE_WINDOW_NICENESS).min(19);
+        assert_eq!(lowered, expected, "the window's thread is lowered");
+        assert_eq!(
+            started, expected,
+            "threads it starts inherit the lower priority"
+        );
+        assert_eq!(
+            nice(simulation_tid),
+            before,
+            "the simulation's thread is not"
+        );
+        go_tx.send(()).unwrap();
+        simulation.join().unwrap();
     }
 }
