@@ -420,7 +420,7 @@ fn plot(
         .allow_boxed_zoom(false)
         // No fill, only a frame: the panel colour shows through. Under a software
         // rasteriser egui's fill of the three open plots cost ~7 ms of the ~75 ms of CPU a
-        // frame takes at 1600 × 900 (docs/performance.md, "The window's frame").
+        // frame takes at 1600 × 900 (docs/performance.md, stop 56).
         .show_background(false)
         .auto_bounds(true)
         .include_x(0.0)
