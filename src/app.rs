@@ -68,7 +68,7 @@ fn software_frames_yield(
     if let egui_wgpu::WgpuSetup::CreateNew(create) = &mut options.wgpu_setup {
         let descriptor = create.device_descriptor.clone();
         create.device_descriptor = Arc::new(move |adapter: &wgpu::Adapter| {
-            if adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+            if draws_in_software(&adapter.get_info()) {
                 lower_this_threads_priority(SOFTWARE_WINDOW_NICENESS);
             }
             descriptor(adapter)
@@ -91,9 +91,15 @@ fn lower_this_threads_priority(niceness: i32) {
 #[cfg(not(target_os = "linux"))]
 fn lower_this_threads_priority(_niceness: i32) {}
 
+/// Whether the adapter rasterises on the CPU (Mesa's llvmpipe, a machine without a GPU),
+/// where a frame takes CPU from the simulation.
+fn draws_in_software(adapter: &wgpu::AdapterInfo) -> bool {
+    adapter.device_type == wgpu::DeviceType::Cpu
+}
+
 /// How often the window redraws while a run computes, for the adapter that draws it.
 fn computing_frame_interval(adapter: &wgpu::AdapterInfo) -> Duration {
-    if adapter.device_type == wgpu::DeviceType::Cpu {
+    if draws_in_software(adapter) {
         SOFTWARE_COMPUTING_FRAME_INTERVAL
     } else {
         COMPUTING_FRAME_INTERVAL

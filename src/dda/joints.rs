@@ -603,7 +603,7 @@ impl Connection {
 
     /// The nodes as (block, current position).
     pub fn node_list(&self) -> [(usize, Point); 3] {
-        std::array::from_fn(|k| (self.blocks[k], self.nodes[k]))
+        std::array::from_fn(|k| self.node(k))
     }
 
     /// `ke = A Bᵀ C B` (6 × 6, row-major) and `fe = A Bᵀ σ` on the three nodes, node pair
