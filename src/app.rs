@@ -25,14 +25,14 @@ const FRAME_INTERVAL: Duration = Duration::from_micros(16_667);
 /// While a run is being computed the window redraws at most this often (10 frames a
 /// second): its frames are drawn by the same cores that compute. The default run then
 /// computes at 22–23× real time in the window instead of 17–18× at 30 frames a second
-/// (docs/performance.md); the computation lasts a second or two.
+/// (docs/performance-log.md); the computation lasts a second or two.
 const COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(100);
 
 /// The same where the frames are drawn in software (Mesa's llvmpipe, a machine without a
 /// GPU): there a frame of the default layout at 1600×900 costs ~80–90 ms of CPU, taken
 /// from the two simulations on the same cores. At 10 frames a second the run computed at
 /// 17–18× real time under Xvfb, at 4 a second 24–29×, at 2 a second 26–31×
-/// (docs/performance.md). Input still repaints at once, and the end of the run is shown
+/// (docs/performance-log.md). Input still repaints at once, and the end of the run is shown
 /// at once (see [`Wake`]); only the computing run's own progress frames are paced.
 const SOFTWARE_COMPUTING_FRAME_INTERVAL: Duration = Duration::from_millis(500);
 

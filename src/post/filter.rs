@@ -6,7 +6,7 @@
 //! stick events: a velocity jump taken over one step reads as Δv/Δt. Their heights depend
 //! on where the event falls within its step, so on Δt, the integrator and the linear
 //! solver's path to round-off; their impulses do not. Measured on `wall:22` under the
-//! first 12 s of Kobe (docs/performance.md, "How well defined a wall's peaks are"): the
+//! first 12 s of Kobe (docs/performance-log.md, "How well defined a wall's peaks are"): the
 //! raw peak base acceleration was 0.52–0.84 g across two step sizes, two integrators and
 //! two solver paths, the low-passed one 0.11 g in all five.
 //!

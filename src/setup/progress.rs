@@ -85,7 +85,7 @@ const INTENSITY_SPACING_S: f64 = 1e-3;
 /// then `a·(T − t) + b·(J(T) − J(t))`.
 ///
 /// Measured under all of Kobe, reports every 5 s, over the reports with more than 10 s
-/// left (docs/performance.md): on `wall:30` the estimate was 0.39–1.56 times the true
+/// left (docs/performance-log.md): on `wall:30` the estimate was 0.39–1.56 times the true
 /// time left, median 1.20, where the plain pace was 0.38–3.17 times, median 2.37; on
 /// `wall:20` 0.56–1.41 (median 1.25) against 0.56–2.80 (2.12). The first reports, before
 /// the strong motion, still underestimate it: nothing so far tells its cost. Under steady

@@ -377,7 +377,7 @@ impl PreparedRun {
     /// runs through all of them on its own thread: the threads meet once per call, not
     /// once per frame (the default scene's two frames on two cores, against one after the
     /// other: 1.4× faster with a meeting per frame, 1.8× with one per 64 frames;
-    /// docs/performance.md).
+    /// docs/performance-log.md).
     pub fn advance_frames(
         &mut self,
         times: &[f64],

@@ -60,7 +60,7 @@ pub struct Curve {
 
 /// A low-passed peak this far below the raw one is worth a mention in the legend: the
 /// raw peak is then a spike one to three steps wide (an impact, a base that sticks), whose
-/// height depends on the step size (docs/performance.md, stop 47). On the three-storey
+/// height depends on the step size (docs/performance-log.md, stop 47). On the three-storey
 /// the two differ by 1 %; on a block wall by a factor of two to five.
 const SPIKY: f64 = 0.9;
 
@@ -420,7 +420,7 @@ fn plot(
         .allow_boxed_zoom(false)
         // No fill, only a frame: the panel colour shows through. Under a software
         // rasteriser egui's fill of the three open plots cost ~7 ms of the ~75 ms of CPU a
-        // frame takes at 1600 × 900 (docs/performance.md, stop 56).
+        // frame takes at 1600 × 900 (docs/performance-log.md, stop 56).
         .show_background(false)
         .auto_bounds(true)
         .include_x(0.0)

@@ -5,7 +5,7 @@
 //! its matrix by value and returns it in an `Option`, and the slot that keeps it receives
 //! it by assignment: for the two-block model's 12 × 12 system that was five copies of
 //! 1152 bytes per factorisation, a tenth of the run's time spent in `memcpy`
-//! (docs/performance.md).
+//! (docs/performance-log.md).
 
 /// A Cholesky factor `L` (lower triangle, column by column) of an `N × N` symmetric
 /// positive definite matrix.
