@@ -127,6 +127,22 @@ fn bad_at2_files() {
         5,
         "not finite",
     );
+    // Another unit or quantity than acceleration in g, declared in the header: refused
+    // at the line that declares it (read as g, 15 cm/s² was 15 g).
+    let body = "NPTS= 3, DT= .01 SEC\n1 2 3\n";
+    for (third, fragment) in [
+        (
+            "ACCELERATION TIME SERIES IN UNITS OF CM/SEC/SEC",
+            "UNITS OF CM/SEC/SEC",
+        ),
+        ("VELOCITY TIME SERIES IN UNITS OF CM/S", "VELOCITY"),
+        ("DISPLACEMENT TIME SERIES IN UNITS OF CM", "DISPLACEMENT"),
+    ] {
+        let text = format!("PEER NGA STRONG MOTION DATABASE RECORD\nTest\n{third}\n{body}");
+        assert_parse_error(parse_at2(&text, "u.AT2", "u"), 3, fragment);
+    }
+    let in_g = format!("PEER\nTest\nACCELERATION TIME SERIES IN UNITS OF G\n{body}");
+    assert!(parse_at2(&in_g, "g.AT2", "g").is_ok());
 }
 
 #[test]
@@ -169,6 +185,20 @@ fn bad_text_files() {
         1,
         "at least two samples",
     );
+    // A header naming another unit or quantity for the acceleration column.
+    for header in [
+        "time_s,accel_m_s2",
+        "t,acc_cm_s2",
+        "time;gal",
+        "time_s,velocity",
+    ] {
+        let text = format!("# a record\n{header}\n0,0\n0.01,0.1\n");
+        assert_parse_error(parse_text(&text, "h.csv", "h"), 2, "read in g");
+    }
+    for header in ["time_s,accel_g", "time,acceleration", "t,a"] {
+        let text = format!("{header}\n0,0\n0.01,0.1\n");
+        assert!(parse_text(&text, "g.csv", "g").is_ok(), "{header}");
+    }
 }
 
 #[test]

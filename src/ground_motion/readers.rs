@@ -74,6 +74,34 @@ fn header_value(upper: &str, key: &str) -> Option<f64> {
     parse_number(&rest[..end])
 }
 
+/// Refuses an AT2 file whose free header lines declare another quantity than acceleration
+/// (a PEER `.VT2` or `.DT2` renamed) or another unit than g (`UNITS OF CM/SEC/SEC`): read
+/// as g, 15 cm/s² became 15 g and a velocity ran as an acceleration without a word.
+fn check_at2_quantity(header: &[&str], file: &str) -> Result<()> {
+    for (k, line) in header.iter().enumerate() {
+        let upper = line.trim().to_uppercase();
+        let other_quantity = ["VELOCITY", "DISPLACEMENT"]
+            .into_iter()
+            .find(|q| upper.starts_with(q));
+        let unit = upper
+            .find("UNITS OF")
+            .map(|at| upper[at + "UNITS OF".len()..].trim());
+        let other_unit = unit.filter(|u| u.split_whitespace().next() != Some("G"));
+        if other_quantity.is_some() || other_unit.is_some() {
+            return Err(Error::record(
+                file,
+                k + 1,
+                format!(
+                    "the header declares '{}'; a record is read as ground acceleration in \
+                     g (a PEER acceleration file says 'UNITS OF G'): convert it to g",
+                    line.trim()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Parses a PEER `.AT2` file: three free header lines, a fourth with the sample count and
 /// step (`NPTS=  5372, DT=   .0100 SEC`, or the older `  4000   .01000   NPTS, DT`), then the
 /// accelerations in g, any number per line. The first value is at t = 0.
@@ -89,6 +117,7 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
             "an AT2 file needs four header lines (the fourth gives NPTS and DT)",
         ));
     }
+    check_at2_quantity(&lines[..3], file_label)?;
     let header = lines[3];
     let upper = header.to_uppercase();
     let (npts, dt) =
@@ -204,6 +233,46 @@ fn is_header(fields: &[&str]) -> bool {
         })
 }
 
+/// Refuses a header row whose acceleration column names another unit than g
+/// (`accel_m_s2`, `acc_cm_s2`, `gal`) or another quantity (`velocity`, `disp_cm`): the
+/// column is read in g, and `time_s,accel_m_s2` ran a record as 9.81 times itself.
+fn check_column_units(fields: &[&str], file: &str, line: usize) -> Result<()> {
+    let Some(column) = fields.get(1) else {
+        return Ok(());
+    };
+    let lower = column
+        .trim_matches(|c| c == '"' || c == '\'')
+        .to_lowercase();
+    // The name's words: `accel_m_s2` → accel, m, s2; `acc(cm/s^2)` → acc, cm, s, 2.
+    let words: Vec<&str> = lower
+        .split(|c: char| !c.is_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .collect();
+    let has = |w: &str| words.contains(&w);
+    let other_unit = has("m")
+        || has("cm")
+        || has("mm")
+        || has("gal")
+        || has("ft")
+        || has("in")
+        || has("ms2")
+        || has("mps2");
+    let other_quantity = words
+        .iter()
+        .any(|w| w.starts_with("vel") || w.starts_with("disp"));
+    if other_unit || other_quantity {
+        return Err(Error::record(
+            file,
+            line,
+            format!(
+                "the acceleration column is named '{column}'; it is read in g (a header such \
+                 as `time_s,accel_g`): convert the record to g"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Parses two-column text: time (s) and acceleration (g), separated by commas, semicolons,
 /// tabs or spaces; `#` comment lines (kept as provenance), blank lines and one header line
 /// before the data are allowed. Times must increase uniformly from 0 (or from one step,
@@ -226,6 +295,7 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
             .filter(|t| !t.is_empty())
             .collect();
         if rows.is_empty() && !header_seen && is_header(&fields) {
+            check_column_units(&fields, file_label, k + 1)?;
             header_seen = true;
             continue;
         }
