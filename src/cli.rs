@@ -493,12 +493,15 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     warn(&s.warnings);
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
     out(&format!(
-        "{} ({}), α = {}, ρ = {}, {}{}, {:.1} s",
+        "{} ({}), α = {}, {}, {}{}, {:.1} s",
         s.scene,
         s.model,
         s.alpha,
-        s.friction
-            .map_or("∞ (fixed base)".into(), |f| f.to_string()),
+        match (&s.friction_law, s.friction) {
+            (Some(law), _) => format!("friction {law}"),
+            (None, Some(f)) => format!("ρ = {f}"),
+            (None, None) => "ρ = ∞ (fixed base)".into(),
+        },
         s.excitation,
         with_vertical(
             &s.freq_ratio
@@ -697,6 +700,9 @@ fn bench_repeats(quick: bool, repeat: Option<usize>) -> Result<usize> {
 fn cmd_bench(args: BenchArgs) -> Result<()> {
     use slidebase::headless::bench::{BenchOptions, report_text, run_bench, write_bench};
     let repeats = bench_repeats(args.quick, args.repeat)?;
+    if args.no_sweep && args.jobs.is_some() {
+        bail!("invalid --jobs: it sets the sweep's threads, and --no-sweep leaves the sweep out");
+    }
     if let Some(dir) = &args.out {
         slidebase::post::output::prepare_dir(dir)?;
     }
@@ -775,7 +781,10 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         return out(&serde_json::to_string(s)?);
     }
     warn(&s.warnings);
-    let friction = s.friction.map(|f| format!("ρ = {f}"));
+    let friction = match (&s.friction_law, s.friction) {
+        (Some(law), _) => Some(format!("friction {law}")),
+        (None, f) => f.map(|f| format!("ρ = {f}")),
+    };
     out(&run_header(
         &s.scene,
         &s.model,
@@ -891,6 +900,10 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     use slidebase::export::{PictureOptions, VideoFormat, render_picture, render_video};
     use slidebase::sim::{Excitation, SimConfig};
     let video = check_picture(&args)?;
+    slidebase::post::output::prepare_file_for(&args.out, "--out")?;
+    if let Some(dir) = &args.data {
+        slidebase::post::output::prepare_dir_for(dir, "--data")?;
+    }
     let config = SimConfig {
         scene: args.scene,
         friction: args.friction,
@@ -918,13 +931,14 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
                     args.out.display()
                 );
             }
-            let to = match args.to {
-                Some(t) => t,
-                None => slidebase::sim::prepare(&config)?.duration,
-            };
+            let end = slidebase::sim::prepare(&config)?.duration;
+            let from = args.from.unwrap_or(0.0);
+            within_run("--from", from, end)?;
+            let to = args.to.unwrap_or(end);
+            within_run("--to", to, end)?;
             render_video(
                 &config,
-                args.from.unwrap_or(0.0),
+                from,
                 to,
                 args.fps.unwrap_or(25.0),
                 &options,
@@ -945,13 +959,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
                     );
                 }
             }
-            render_picture(
-                &config,
-                args.time.unwrap_or(5.0),
-                &options,
-                &args.out,
-                args.data.as_deref(),
-            )?
+            let time = args.time.unwrap_or(5.0);
+            within_run("--time", time, slidebase::sim::prepare(&config)?.duration)?;
+            render_picture(&config, time, &options, &args.out, args.data.as_deref())?
         }
     };
     if let Some(note) = &info.note {
@@ -967,6 +977,20 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
         info.simulate_s,
         info.render_s
     ))
+}
+
+/// Refuses a time (named by `flag`) after the end of the run (`end`, s): the picture
+/// would show the run's last instant under a label it does not have.
+#[cfg(feature = "gui")]
+fn within_run(flag: &str, time: f64, end: f64) -> Result<()> {
+    // A millionth of a step's slack: `--to` is often the duration itself, as printed.
+    if time > end + 1e-9 * end.max(1.0) {
+        bail!(
+            "invalid {flag}: {} s is after the end of the run ({end} s); give a time in [0, {end}]",
+            slidebase::error::show(time)
+        );
+    }
+    Ok(())
 }
 
 #[cfg(not(feature = "gui"))]
@@ -1037,7 +1061,7 @@ fn cmd_report(args: ReportArgs) -> Result<()> {
         confirm_large: args.confirm_large,
     };
     // The runs' set-up and the output folder are checked before the first run.
-    req.spec().prepare()?;
+    req.check()?;
     slidebase::post::output::prepare_dir(&args.out)?;
     let bar = ProgressBar::new_spinner();
     bar.set_message("running sliding and fixed base (DDA, two integrators) and the MDOF model…");

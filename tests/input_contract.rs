@@ -968,3 +968,147 @@ fn a_missing_scene_or_record_file_is_named_as_missing() {
     let e = resolve_scene("no-such-scene").unwrap_err().to_string();
     assert_has(&e, &["unknown scene 'no-such-scene'"]);
 }
+
+// ---- found by a new user's audit (stop 57) ---------------------------------------------
+
+#[test]
+fn a_dish_on_the_large_mass_ground_is_refused() {
+    use slidebase::model::bearing::Bearing;
+    let e = spec_error(RunSpec {
+        bearing: Some(Bearing::parse("pendulum:2").unwrap()),
+        ground: Some(GroundKind::LargeMass),
+        ..RunSpec::scene("three-storey")
+    });
+    assert_has(&e, &["--ground", "--bearing", "prescribed"]);
+    let e = spec_error(RunSpec {
+        ground: Some(GroundKind::LargeMass),
+        ..RunSpec::scene("friction-pendulum")
+    });
+    assert_has(&e, &["--ground", "dish", "prescribed"]);
+}
+
+#[test]
+fn a_bearing_under_a_fixed_base_is_a_conflict() {
+    use slidebase::model::bearing::Bearing;
+    let e = spec_error(RunSpec {
+        bearing: Some(Bearing::parse("pendulum:2").unwrap()),
+        fixed_base: true,
+        ..RunSpec::scene("three-storey")
+    });
+    assert_has(&e, &["--bearing", "conflicts with --fixed-base"]);
+}
+
+#[test]
+fn an_infinite_friction_law_is_refused_as_infinite_friction_is() {
+    let e = spec_error(RunSpec {
+        friction_law: Some("coulomb:inf".parse().unwrap()),
+        ..RunSpec::scene("block")
+    });
+    assert_has(&e, &["--friction-law", "--fixed-base"]);
+}
+
+/// A law other than Coulomb's is named in the summary: its sticking coefficient alone hid
+/// that the base slid against a lower one.
+#[test]
+fn a_friction_law_is_reported_with_the_run() {
+    let law = "static-kinetic:0.05,0.01";
+    let building = run_frame(&RunSpec {
+        friction_law: Some(law.parse().unwrap()),
+        duration: Some(0.5),
+        ..RunSpec::scene("three-storey")
+    })
+    .unwrap();
+    assert_eq!(building.summary.friction_law.as_deref(), Some(law));
+    let two_block = run(&RunSpec {
+        friction_law: Some(law.parse().unwrap()),
+        duration: Some(0.5),
+        ..RunSpec::scene("two-block")
+    })
+    .unwrap();
+    assert_eq!(two_block.summary.friction_law.as_deref(), Some(law));
+    let coulomb = run(&RunSpec {
+        duration: Some(0.5),
+        ..RunSpec::scene("two-block")
+    })
+    .unwrap();
+    assert_eq!(coulomb.summary.friction_law, None);
+}
+
+#[test]
+fn modes_and_report_refuse_a_stack_of_blocks() {
+    let wall = resolve_scene("wall:3").unwrap();
+    let e = modes(&wall).unwrap_err().to_string();
+    assert_has(&e, &["wall:3", "stack of blocks in contact", "between '"]);
+    for scene in ["wall:3", "two-block"] {
+        let req = slidebase::headless::report::ReportRequest {
+            scene: scene.into(),
+            record: None,
+            friction: None,
+            dt: None,
+            duration: Some(1.0),
+            confirm_large: false,
+        };
+        let e = req.check().unwrap_err().to_string();
+        assert_has(&e, &["--scene", scene]);
+    }
+}
+
+#[test]
+fn a_contact_of_three_blocks_is_refused() {
+    let text = BLOCK.replace(
+        "blocks = [\"block\", \"ground\"]",
+        "blocks = [\"block\", \"ground\", \"ground\"]",
+    );
+    assert_ne!(text, BLOCK);
+    assert_has(&scene_error(&text), &["two blocks", "got 3 names"]);
+}
+
+#[test]
+fn bench_refuses_jobs_without_its_sweep() {
+    let (code, _, err) = cli(&["bench", "--no-sweep", "--jobs", "2"]);
+    assert_ne!(code, 0);
+    assert_has(&err, &["--jobs", "--no-sweep"]);
+}
+
+#[cfg(feature = "gui")]
+#[test]
+fn render_refuses_a_time_after_the_run_and_unusable_outputs() {
+    let dir = std::env::temp_dir().join(format!("slidebase-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a-file");
+    std::fs::write(&file, b"").unwrap();
+    let png = dir.join("t.png");
+    let png = png.to_str().unwrap();
+    for (args, fragments) in [
+        (
+            vec!["--time", "40", "--out", png],
+            vec!["--time", "after the end"],
+        ),
+        (
+            vec!["--from", "50", "--out", dir.join("t.gif").to_str().unwrap()],
+            vec!["--from", "after the end"],
+        ),
+        (
+            vec![
+                "--time",
+                "1",
+                "--data",
+                file.to_str().unwrap(),
+                "--out",
+                png,
+            ],
+            vec!["--data", "not a folder"],
+        ),
+        (
+            vec!["--time", "1", "--out", file.join("x.png").to_str().unwrap()],
+            vec!["--out", "is not a folder"],
+        ),
+    ] {
+        let mut all = vec!["render"];
+        all.extend(args);
+        let (code, _, err) = cli(&all);
+        assert_ne!(code, 0, "{all:?}");
+        assert_has(&err, &fragments);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

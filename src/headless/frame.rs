@@ -19,7 +19,7 @@ use crate::{Error, Result};
 /// The paper's natural frequencies of its three-storey frame, Hz.
 pub const PAPER_FREQUENCIES_HZ: [f64; 3] = [0.638, 1.788, 2.583];
 
-pub use crate::setup::modes::{ModesReport, modes, roles};
+pub use crate::setup::modes::{ModesReport, frame_roles, modes, roles};
 
 /// Summary of a building run (the JSON object of `run --json`). A quantity that is
 /// undefined for the run is left out (never `null`), and `warnings` says why.
@@ -43,9 +43,14 @@ pub struct FrameSummary {
     /// The bearing under the base slab, `pendulum:R`, when it is not the flat joint.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bearing: Option<String>,
-    /// Friction coefficient (absent for a fixed base).
+    /// Friction coefficient (absent for a fixed base); with a law other than Coulomb's,
+    /// its sticking coefficient.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
+    /// The sliding joint's friction law when it is not Coulomb's (see
+    /// [`super::run::reported_law`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_law: Option<String>,
     /// Fixed base.
     pub fixed_base: bool,
     /// Duration, s.
@@ -198,6 +203,7 @@ fn summarise(
         damping: (setup.damping_ratio > 0.0).then_some(setup.damping_ratio),
         bearing: setup.bearing_radius.map(|r| format!("pendulum:{r}")),
         friction: super::run::reported_friction(setup, &mut warnings),
+        friction_law: super::run::reported_law(setup),
         fixed_base: setup.fixed_base,
         duration_s: setup.duration,
         max_slip_m: p.slip_m,
@@ -233,7 +239,7 @@ pub fn equivalent_mdof_with(
     scene: &Scene,
     report: ModesReport,
 ) -> Result<(ShearBuilding, ModesReport)> {
-    let r = roles(scene)?;
+    let r = frame_roles(scene)?;
     if let Some(f) = report
         .frequencies_hz
         .iter()
@@ -489,7 +495,7 @@ pub fn free_vibration_frequencies(
     dt: f64,
     count: usize,
 ) -> Result<Vec<f64>> {
-    let r = roles(scene)?;
+    let r = frame_roles(scene)?;
     let mut scene = scene.clone();
     for c in scene.contacts.iter_mut().filter(|c| c.name == r.joint) {
         c.bonded = true;

@@ -50,6 +50,35 @@ pub struct ReportRuns {
 }
 
 impl ReportRequest {
+    /// Checks the request before any run: its set-up, and that its scene is a frame (the
+    /// report compares a frame's DDA runs with its equivalent shear building).
+    pub fn check(&self) -> Result<()> {
+        let setup = self.spec().prepare()?;
+        if !matches!(setup.roles, crate::setup::SceneRoles::Building(_)) {
+            return Err(crate::Error::invalid(
+                "--scene",
+                format!(
+                    "the report studies a frame on a sliding base (three-storey, frame:N); \
+                     '{}' is not a building scene (for the two-block model's figures use \
+                     `slidebase sweep`)",
+                    setup.scene.name
+                ),
+            ));
+        }
+        if setup.friction.is_infinite() {
+            return Err(crate::Error::invalid(
+                "--friction",
+                format!(
+                    "scene '{}' gives its sliding joint friction = inf (it never slides): \
+                     the report compares a sliding base with a fixed one; give a finite \
+                     coefficient with --friction",
+                    setup.scene.name
+                ),
+            ));
+        }
+        crate::setup::modes::frame_roles(&setup.scene).map(|_| ())
+    }
+
     /// The run specification of the sliding DDA run (the others vary it).
     pub fn spec(&self) -> RunSpec {
         RunSpec {
@@ -237,11 +266,15 @@ pub fn write_report(req: &ReportRequest, runs: &ReportRuns, out: &Path) -> Resul
                 spectrum_series(&g_spec, "ground", 6, 10.0),
             ],
             vec![format!(
-                "highest peak {} Hz; below 1 Hz: {:.2} Hz (paper: about 0.35 Hz)",
+                "highest peak {} Hz; below 1 Hz: {} Hz (paper: about 0.35 Hz)",
                 s.summary
                     .base_accel_peak_freq_hz
                     .map_or("–".to_string(), |f| format!("{f:.2}")),
-                b_low.0
+                if b_low.0.is_finite() {
+                    format!("{:.2}", b_low.0)
+                } else {
+                    "none".to_string()
+                }
             )],
         ),
     )?;
@@ -347,8 +380,13 @@ pub fn summary_markdown(
     w(
         &mut s,
         format!(
-            "Friction ρ = {}, Δt = {} s, {:.2} s of record. DDA with generalised-α (ρ∞ = 0, the default) and with the classic DDA update (the paper's); MDOF = the equivalent shear building on a sliding raft (floor masses from the blocks, storey stiffnesses fitted to the DDA frequencies), solved exactly.\n",
-            r.sliding.summary.friction.unwrap_or(f64::NAN),
+            "Friction {}, Δt = {} s, {:.2} s of record. DDA with generalised-α (ρ∞ = 0, the default) and with the classic DDA update (the paper's); MDOF = the equivalent shear building on a sliding raft (floor masses from the blocks, storey stiffnesses fitted to the DDA frequencies), solved exactly.\n",
+            match (&r.sliding.summary.friction_law, r.sliding.summary.friction) {
+                (Some(law), _) => law.clone(),
+                (None, Some(f)) => format!("ρ = {f}"),
+                // `check` refuses a joint that never slides.
+                (None, None) => "ρ = ∞".into(),
+            },
             req.dt.unwrap_or(crate::setup::defaults::DT),
             r.sliding.summary.duration_s
         ),

@@ -25,9 +25,14 @@ pub struct RunSummary {
     pub integrator: Option<String>,
     /// Mass ratio α.
     pub alpha: f64,
-    /// Friction coefficient ρ (absent when the base is fixed).
+    /// Friction coefficient ρ (absent when the base is fixed); with a law other than
+    /// Coulomb's, its sticking coefficient.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
+    /// The sliding joint's friction law when it is not Coulomb's (see
+    /// [`reported_law`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_law: Option<String>,
     /// Whether the base was fixed.
     pub fixed_base: bool,
     /// Ω/ω (harmonic input only).
@@ -140,6 +145,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         integrator: (!exact).then(|| setup.integrator.label()),
         alpha,
         friction: reported_friction(setup, &mut warnings),
+        friction_law: reported_law(setup),
         fixed_base: setup.fixed_base,
         freq_ratio,
         excitation: setup.excitation_label.clone(),
@@ -184,6 +190,17 @@ pub fn reported_friction(setup: &RunSetup, warnings: &mut Vec<String>) -> Option
         return None;
     }
     Some(setup.friction)
+}
+
+/// The sliding joint's law when it is not Coulomb's (`static-kinetic:μs,μk`,
+/// `velocity:μslow,μfast,rate`): `friction` alone, its sticking coefficient, would hide
+/// that the run slid against a lower or speed-dependent one.
+pub fn reported_law(setup: &RunSetup) -> Option<String> {
+    match setup.joint_law() {
+        _ if setup.fixed_base => None,
+        crate::model::friction::Friction::Coulomb(_) => None,
+        law => Some(law.to_string()),
+    }
 }
 
 /// `Some(x)` when x is finite.

@@ -61,20 +61,67 @@ pub fn parse_list(flag: &str, text: &str) -> Result<Vec<f64>> {
             format!("{count} values; a list may have at most {MAX_LIST_VALUES}"),
         ));
     }
+    if text.trim().is_empty() {
+        return Err(Error::invalid(flag, "the list is empty"));
+    }
     let values: Result<Vec<f64>> = text
         .split(',')
         .map(|s| s.trim())
-        .filter(|s| !s.is_empty())
-        .map(|s| {
+        .enumerate()
+        .map(|(k, s)| {
+            if s.is_empty() {
+                // `0.5,` or `,0.5`: a value left out, not a list of one.
+                return Err(Error::invalid(
+                    flag,
+                    format!(
+                        "value {} of '{text}' is empty; give numbers separated by commas",
+                        k + 1
+                    ),
+                ));
+            }
             s.parse::<f64>()
                 .map_err(|_| Error::invalid(flag, format!("'{s}' is not a number")))
         })
         .collect();
     let values = values?;
-    if values.is_empty() {
-        return Err(Error::invalid(flag, "the list is empty"));
-    }
+    distinct(flag, &values)?;
     Ok(values)
+}
+
+/// A run's error in the words of the sweep's flags: a run's `--freq-ratio` is one of the
+/// sweep's `--freq-ratios`, and a friction that never slides has no `--fixed-base` to
+/// turn to in a sweep (the grid is of sliding bases).
+fn as_sweep_error(e: Error) -> Error {
+    match e {
+        Error::InvalidParameter { field, message } => {
+            let message = if field == "--friction" && message.contains("--fixed-base") {
+                "inf: the sweep's grid is of sliding bases; give finite coefficients".into()
+            } else {
+                message
+            };
+            let field = if field == "--freq-ratio" {
+                "--freq-ratios".into()
+            } else {
+                field
+            };
+            Error::InvalidParameter { field, message }
+        }
+        other => other,
+    }
+}
+
+/// Refuses a value given twice: a grid runs each point once (a repeated value ran it
+/// twice, and `merge` then refused the sweep's own table for its repeated rows).
+fn distinct(flag: &str, values: &[f64]) -> Result<()> {
+    for (k, v) in values.iter().enumerate() {
+        if values[..k].contains(v) {
+            return Err(Error::invalid(
+                flag,
+                format!("{v} is given twice; give each value once"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The frequency ratios at which a log-spaced grid is most often read and where the
@@ -135,6 +182,16 @@ pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
         return Err(Error::invalid(
             flag,
             format!("{n} values; a list may have at most {MAX_LIST_VALUES}"),
+        ));
+    }
+    // One value, or several between equal ends, would drop `hi` or repeat `lo`.
+    if (n == 1) != (lo == hi) {
+        return Err(Error::invalid(
+            flag,
+            format!(
+                "{lo}:{hi}:{n} — one value (n = 1) needs lo = hi, and n >= 2 values need \
+                 lo < hi"
+            ),
         ));
     }
     if n == 1 {
@@ -217,7 +274,9 @@ impl SweepRequest {
                 .chain(self.frictions.iter().map(|&f| (a0, f, r0)))
                 .chain(self.freq_ratios.iter().map(|&r| (a0, f0, r)));
             for (a, f, r) in points {
-                self.spec(model, a, f, r).prepare()?;
+                self.spec(model, a, f, r)
+                    .prepare()
+                    .map_err(as_sweep_error)?;
             }
         }
         Ok(())
@@ -326,6 +385,14 @@ mod tests {
             vec![0.5, 2.0]
         );
         assert!(parse_list("--alpha", "0.1,x").is_err());
+        // Left-out values, repeated values and a range that drops an end are refused.
+        for bad in ["0.5,", ",0.5", "0.5,,0.6", "0.5,0.5", " "] {
+            assert!(parse_list("--alpha", bad).is_err(), "{bad}");
+        }
+        for bad in ["0.1:10:1", "1:1:3", "0.5,2,0.5"] {
+            assert!(parse_ratios("--freq-ratios", bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_ratios("--freq-ratios", "2:2:1").unwrap(), vec![2.0]);
     }
 
     #[test]

@@ -187,6 +187,7 @@ pub struct ContactDef {
     #[serde(default)]
     pub name: String,
     /// The two block names.
+    #[serde(deserialize_with = "strict::name_pair")]
     pub blocks: [String; 2],
     /// The friction law: a number is Coulomb's coefficient ρ (static = kinetic, as in the
     /// paper; `inf` never slides); a string names another law
@@ -212,6 +213,18 @@ pub struct ContactDef {
     pub locate_events: bool,
 }
 
+impl ContactDef {
+    /// How a message names the contact: its name, or its two blocks when it has none
+    /// (the generated walls' contacts are unnamed).
+    pub fn label(&self) -> String {
+        if self.name.is_empty() {
+            format!("between '{}' and '{}'", self.blocks[0], self.blocks[1])
+        } else {
+            format!("'{}'", self.name)
+        }
+    }
+}
+
 fn yes() -> bool {
     true
 }
@@ -235,6 +248,7 @@ pub struct BoltDef {
     #[serde(default)]
     pub name: String,
     /// The two block names.
+    #[serde(deserialize_with = "strict::name_pair")]
     pub blocks: [String; 2],
     /// End points (in the respective blocks), m.
     #[serde(deserialize_with = "strict::point_pair")]
@@ -360,8 +374,8 @@ pub struct VerticalExcitationDef {
     pub scale: f64,
 }
 
-/// Points read strictly: exactly two coordinates (a third would otherwise be dropped
-/// without a word: slidebase is two-dimensional).
+/// Points and pairs read strictly: exactly two coordinates (a third would otherwise be
+/// dropped without a word: slidebase is two-dimensional), exactly two block names.
 mod strict {
     use serde::de::Error as _;
     use serde::{Deserialize, Deserializer};
@@ -387,6 +401,19 @@ mod strict {
             .into_iter()
             .map(exactly_two)
             .collect()
+    }
+
+    /// Two block names (a contact or a bolt joins two blocks; a third name would otherwise
+    /// be dropped without a word).
+    pub fn name_pair<'de, D: Deserializer<'de>>(d: D) -> Result<[String; 2], D::Error> {
+        let v = Vec::<String>::deserialize(d)?;
+        match <[String; 2]>::try_from(v) {
+            Ok(pair) => Ok(pair),
+            Err(v) => Err(D::Error::custom(format!(
+                "`blocks` names the two blocks it joins, got {} names",
+                v.len()
+            ))),
+        }
     }
 
     pub fn point_pair<'de, D: Deserializer<'de>>(d: D) -> Result<[Point; 2], D::Error> {

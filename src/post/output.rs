@@ -11,10 +11,15 @@ use crate::{Error, Result};
 /// Makes sure `dir` is (or can be made) a folder this process can write into. Called
 /// before a run starts, so that a bad `--out` is reported at once, not after the work.
 pub fn prepare_dir(dir: &Path) -> Result<()> {
+    prepare_dir_for(dir, "--out")
+}
+
+/// [`prepare_dir`] for the folder that `flag` names.
+pub fn prepare_dir_for(dir: &Path, flag: &str) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(Error::output(
             dir,
-            "exists and is not a folder; --out names a folder for the output files",
+            format!("exists and is not a folder; {flag} names a folder for the output files"),
         ));
     }
     std::fs::create_dir_all(dir)
@@ -24,6 +29,32 @@ pub fn prepare_dir(dir: &Path) -> Result<()> {
         .map_err(|e| Error::output(dir, format!("cannot write into the folder: {e}")))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
+}
+
+/// Makes sure the file `path` (named by `flag`) can be written: its folder is (or can be
+/// made) a writable folder and the path itself is not a folder. Checked before the work
+/// that produces the file, as [`prepare_dir`] is.
+pub fn prepare_file_for(path: &Path, flag: &str) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::output(
+            path,
+            format!("is a folder; {flag} names the file to write"),
+        ));
+    }
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if folder.exists() && !folder.is_dir() {
+        return Err(Error::output(
+            folder,
+            format!(
+                "is not a folder, so {flag} {} cannot be written in it",
+                path.display()
+            ),
+        ));
+    }
+    prepare_dir_for(folder, flag)
 }
 
 /// The video formats a replay is written in.

@@ -175,10 +175,17 @@ impl UniformSeries {
 impl Spectrum {
     /// The highest peak with f in [f_min, f_max]: (frequency, amplitude), the frequency
     /// refined by a parabola through the peak bin and its neighbours (sub-bin accuracy).
+    /// A peak is a local maximum: the highest bin of the window when it sits on the
+    /// shoulder of a peak outside it is not one (the report's "peak below 1 Hz" was the
+    /// 1 Hz edge of the 2.7 Hz peak's shoulder), and a window without one has none.
     pub fn peak(&self, f_min: f64, f_max: f64) -> Option<(f64, f64)> {
-        let k = (0..self.amplitude.len())
-            .filter(|&k| self.freq_hz[k] >= f_min && self.freq_hz[k] <= f_max)
-            .max_by(|&a, &b| self.amplitude[a].total_cmp(&self.amplitude[b]))?;
+        let a = &self.amplitude;
+        // The spectrum's own ends count (a constant peaks at 0 Hz); the window's do not.
+        let local_max =
+            |k: usize| (k == 0 || a[k] > a[k - 1]) && (k + 1 == a.len() || a[k] >= a[k + 1]);
+        let k = (0..a.len())
+            .filter(|&k| self.freq_hz[k] >= f_min && self.freq_hz[k] <= f_max && local_max(k))
+            .max_by(|&x, &y| a[x].total_cmp(&a[y]))?;
         Some(self.refine(k))
     }
 
@@ -238,6 +245,15 @@ mod tests {
         );
         let c = fourier_amplitude(&[1.0; 64], 0.1).unwrap();
         assert_eq!(c.peak(0.0, 100.0).unwrap().0, 0.0);
+        // A window on a peak's shoulder holds no peak, however high its edge.
+        let shoulder = Spectrum {
+            freq_hz: vec![0.0, 0.5, 1.0, 1.5, 2.0, 2.5],
+            amplitude: vec![0.5, 1.0, 2.0, 3.0, 2.0, 1.0],
+        };
+        assert_eq!(shoulder.peak(0.1, 1.2), None);
+        assert_eq!(shoulder.peak(1.8, 3.0), None);
+        assert_eq!(shoulder.peak(0.1, 3.0).map(|p| p.0), Some(1.5));
+        assert_eq!(shoulder.peak(0.0, 0.2).map(|p| p.0), None);
         assert!(fourier_amplitude(&[1.0, f64::NAN], 0.1).is_err());
     }
 

@@ -48,6 +48,13 @@ pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
     if let Some(law) = spec.friction_law {
         law.check()
             .map_err(|e| Error::invalid("--friction-law", e))?;
+        // As for --friction inf: the flag sets how a joint slides, not that it never does.
+        if crate::model::friction::FrictionLaw::sticking_coefficient(&law) == f64::INFINITY {
+            return Err(Error::invalid(
+                "--friction-law",
+                "an infinite coefficient: a joint that never slides is --fixed-base",
+            ));
+        }
     }
     if let Some(f) = spec.friction {
         if f == f64::INFINITY {
@@ -114,15 +121,16 @@ fn check_damping_applies(scene: &Scene) -> Result<()> {
             ),
         ));
     };
-    if let Some(c) = scene.contacts.iter().find(|c| c.name != roles.joint) {
+    if let Some(c) = super::modes::contact_within_structure(scene, roles) {
         return Err(Error::invalid(
             "--damping",
             format!(
                 "Rayleigh damping needs a structure that is one elastic body (blocks joined \
                  by connection elements, as the frame scenes are); '{}' has blocks in \
-                 contact (contact '{}'), whose sliding and rocking on each other the \
+                 contact (contact {}), whose sliding and rocking on each other the \
                  damping would resist",
-                scene.name, c.name
+                scene.name,
+                c.label()
             ),
         ));
     }
@@ -159,6 +167,13 @@ pub(super) fn check_applicable(spec: &RunSpec, scene: &Scene) -> Result<()> {
                  not a frame (for a lone slider on a dish, run --scene friction-pendulum)",
                 scene.name
             ),
+        ));
+    }
+    if spec.fixed_base && spec.bearing.is_some_and(|b| b.radius().is_some()) {
+        return Err(Error::invalid(
+            "--bearing",
+            "conflicts with --fixed-base: a base fixed to the ground sits on no bearing \
+             (run once with each to compare them)",
         ));
     }
     if spec.fixed_base && spec.friction.is_some() {

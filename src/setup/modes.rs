@@ -22,6 +22,38 @@ pub fn roles(scene: &Scene) -> Result<StructureRoles> {
     })
 }
 
+/// A contact between two of a building's blocks other than its sliding joint: such a
+/// building is a stack of blocks (the generated walls), not one elastic frame.
+pub fn contact_within_structure<'a>(
+    scene: &'a Scene,
+    roles: &StructureRoles,
+) -> Option<&'a crate::model::scene::ContactDef> {
+    scene.contacts.iter().find(|c| c.name != roles.joint)
+}
+
+/// The structure roles of a building that is one elastic frame (blocks joined by
+/// connection elements, as three-storey and frame:N are), or an error naming the scene:
+/// natural frequencies, mode shapes and the equivalent shear building are those of such a
+/// frame. A stack of blocks in contact (wall:N) has none: its stuck contacts' penalty
+/// springs would be reported as its stiffness.
+pub fn frame_roles(scene: &Scene) -> Result<StructureRoles> {
+    let r = roles(scene)?;
+    if let Some(c) = contact_within_structure(scene, &r) {
+        return Err(Error::invalid(
+            "--scene",
+            format!(
+                "scene '{}' is a stack of blocks in contact (contact {}), not a frame: \
+                 its natural frequencies would be those of the contacts' penalty springs; \
+                 modes, the equivalent shear building and the paper's report apply to \
+                 frames joined by connection elements (three-storey, frame:N)",
+                scene.name,
+                c.label()
+            ),
+        ));
+    }
+    Ok(r)
+}
+
 /// Natural frequencies and floor mode shapes of a building's fixed-base frame.
 #[derive(Debug, Clone, Serialize)]
 pub struct ModesReport {
@@ -44,7 +76,7 @@ pub struct ModesReport {
 /// Modal analysis of a building scene from the DDA stiffness and mass (fixed base: the
 /// sliding joint's springs held stuck).
 pub fn modes(scene: &Scene) -> Result<ModesReport> {
-    let r = roles(scene)?;
+    let r = frame_roles(scene)?;
     let dda = Dda::new(scene, None, SolverParams::default())?;
     let modes = dda.modes()?;
     let levels: Vec<String> = std::iter::once(r.base.clone())

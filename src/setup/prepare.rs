@@ -14,6 +14,7 @@ use crate::model::Scene;
 use crate::model::bearing::apply_pendulum_bearings;
 use crate::model::friction::{Friction, FrictionLaw};
 use crate::model::presets::{TwoBlockParams, apply_two_block, extend_ground};
+use crate::model::scene::GroundKind;
 use crate::model::scene::{ExcitationDef, SlidingBlockRoles, StructureRoles, TwoBlockRoles};
 use crate::{Error, Result};
 
@@ -137,6 +138,7 @@ impl RunSpec {
         if let Some(kind) = self.ground {
             setup.scene.ground.kind = kind;
         }
+        self.check_dish_on_large_mass(&setup.scene)?;
         setup.vertical = self.vertical_motion(&setup.scene)?;
         setup.warnings = check::check_setup(&setup, self.confirm_large)?;
         Ok(setup)
@@ -315,6 +317,41 @@ impl RunSpec {
         setup.rayleigh = rayleigh;
         setup.bearing_radius = bearing_radius;
         Ok(setup)
+    }
+
+    /// Refuses a dish (a friction pendulum's, or `--bearing pendulum:R`) on the large-mass
+    /// ground: that ground rides on rollers and is pushed along one line, and a block
+    /// climbing its dish pushes it down and sideways as well — the run failed at its first
+    /// step, or gave a roof acceleration six times the exact model's.
+    fn check_dish_on_large_mass(&self, scene: &Scene) -> Result<()> {
+        let ground = &scene.ground;
+        let has_dish = scene
+            .blocks
+            .iter()
+            .any(|b| b.name == ground.block && !b.arcs.is_empty());
+        if ground.kind != GroundKind::LargeMass || !has_dish {
+            return Ok(());
+        }
+        let (what, accepted) = if self.ground.is_some() {
+            ("--ground", "leave out --ground or give --ground prescribed")
+        } else {
+            (
+                "ground.kind",
+                "set ground.kind = \"prescribed\" in the scene file",
+            )
+        };
+        let dish = if self.bearing.is_some_and(|b| b.radius().is_some()) {
+            "the pendulum bearings' dish (--bearing)"
+        } else {
+            "the ground block's dish"
+        };
+        Err(Error::invalid(
+            what,
+            format!(
+                "large-mass: {dish} needs a prescribed ground (the large-mass ground moves \
+                 on rollers along one line and takes flat joints only); {accepted}"
+            ),
+        ))
     }
 
     /// The vertical ground motion: the specification's, or the scene's.
