@@ -664,6 +664,7 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
     // The same grid point from two shards means the shards overlap (or a file was given
     // twice): say so rather than plot it twice.
     slidebase::post::sweep::common_damping(&rows).map_err(|e| anyhow!("invalid merge: {e}"))?;
+    slidebase::post::sweep::common_run(&rows).map_err(|e| anyhow!("invalid merge: {e}"))?;
     let mut seen = std::collections::HashSet::new();
     for r in &rows {
         let key = (

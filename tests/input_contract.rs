@@ -522,12 +522,30 @@ fn merge_refuses_unusable_tables() {
         &["not a sweep table"],
     );
     for (row, what) in [
-        ("dda,0.5,0.1,1,0,NaN,1,1,1,5,0.1,0", "us_max_over_d NaN"),
-        ("dda,-5,0.1,1,0,1,1,1,1,5,0.1,0", "alpha -5"),
-        ("foo,0.5,0.1,1,0,1,1,1,1,5,0.1,0", "unknown model 'foo'"),
-        ("dda,0.5,inf,1,0,1,1,1,1,5,0.1,0", "friction inf"),
-        ("dda,0.5,0.1,1,1.5,1,1,1,1,5,0.1,0", "damping 1.5"),
-        ("dda,0.5,0.1,1,1,1,1,1,5,0.1,0", "11 fields"),
+        (
+            "dda,0.5,0.1,1,0,NaN,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "us_max_over_d NaN",
+        ),
+        (
+            "dda,-5,0.1,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "alpha -5",
+        ),
+        (
+            "foo,0.5,0.1,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "unknown model 'foo'",
+        ),
+        (
+            "dda,0.5,inf,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "friction inf",
+        ),
+        (
+            "dda,0.5,0.1,1,1.5,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "damping 1.5",
+        ),
+        (
+            "dda,0.5,0.1,1,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "15 fields",
+        ),
     ] {
         let e = read_table(&format!("{header}\n{row}\n")).unwrap_err();
         assert_has(&e.to_string(), &["sweep.csv:2", what]);
@@ -1111,4 +1129,43 @@ fn render_refuses_a_time_after_the_run_and_unusable_outputs() {
         assert_has(&err, &fragments);
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Shards run with another duration (or amplitude, Δt, integrator) are not merged: their
+/// rows carry the run's set-up.
+#[test]
+fn merge_refuses_shards_of_other_run_set_ups() {
+    let dir = tempfile::tempdir().unwrap();
+    let row = |ratio: f64, duration: f64| SweepRow {
+        model: "dda".into(),
+        alpha: 0.5,
+        friction: 0.1,
+        freq_ratio: ratio,
+        damping: 0.0,
+        us_max_over_d: 1.0,
+        ur_max_over_d: 1.0,
+        abase_over_aground: 1.0,
+        aroof_over_aground: 1.0,
+        steps: 10,
+        wall_time_s: 0.1,
+        energy_residual_rel: 0.0,
+        amplitude_g: Some(0.3),
+        duration_s: Some(duration),
+        dt_s: Some(1e-3),
+        integrator: Some("generalized-alpha:0.5".into()),
+    };
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    write_sweep_csv(&a, &[row(1.0, 2.0)]).unwrap();
+    write_sweep_csv(&b, &[row(2.0, 5.0)]).unwrap();
+    assert_eq!(read_sweep_csv(&b).unwrap(), vec![row(2.0, 5.0)]);
+    let out = dir.path().join("m");
+    let (code, _, err) = cli(&[
+        "merge",
+        "--out",
+        out.to_str().unwrap(),
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert_has(&err, &["invalid merge", "duration_s", "--duration"]);
 }

@@ -349,6 +349,10 @@ pub fn run_sweep(
                         steps: s.steps,
                         wall_time_s: s.wall_time_s,
                         energy_residual_rel: s.energy_residual_rel,
+                        amplitude_g: Some(s.amplitude_g),
+                        duration_s: Some(s.duration_s),
+                        dt_s: s.dt_s,
+                        integrator: s.integrator.clone(),
                     })
                 }
                 _ => Err(failure(format!(

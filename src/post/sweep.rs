@@ -40,6 +40,19 @@ pub struct SweepRow {
     pub wall_time_s: f64,
     /// Relative energy residual.
     pub energy_residual_rel: f64,
+    /// The run's harmonic amplitude, g (tables written before these run columns have
+    /// none; `merge` compares what the rows have).
+    #[serde(default)]
+    pub amplitude_g: Option<f64>,
+    /// The run's duration, s.
+    #[serde(default)]
+    pub duration_s: Option<f64>,
+    /// The DDA run's time step, s (empty for the exact model, which has none).
+    #[serde(default)]
+    pub dt_s: Option<f64>,
+    /// The DDA run's integrator (empty for the exact model).
+    #[serde(default)]
+    pub integrator: Option<String>,
 }
 
 /// The four metrics by name, in the paper's order.
@@ -52,7 +65,7 @@ pub const METRICS: [&str; 4] = [
 
 impl SweepRow {
     /// The columns of `sweep.csv`, in order.
-    pub const COLUMNS: [&'static str; 12] = [
+    pub const COLUMNS: [&'static str; 16] = [
         "model",
         "alpha",
         "friction",
@@ -65,7 +78,15 @@ impl SweepRow {
         "steps",
         "wall_time_s",
         "energy_residual_rel",
+        "amplitude_g",
+        "duration_s",
+        "dt_s",
+        "integrator",
     ];
+
+    /// The run columns, added last (tables from before them end at
+    /// `energy_residual_rel`).
+    const RUN_COLUMNS: [&'static str; 4] = ["amplitude_g", "duration_s", "dt_s", "integrator"];
 
     /// The ranges a row must be in to be used: known model, α ∈ (0, 1), finite ρ ≥ 0,
     /// finite Ω/ω > 0, finite metrics ≥ 0, at least one step, finite wall time and energy
@@ -158,9 +179,18 @@ pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
         .iter()
         .map(str::to_string)
         .collect();
-    // Tables from before the damping column are read as undamped.
-    let undamped_header = SweepRow::COLUMNS.iter().filter(|c| **c != "damping");
-    if header != SweepRow::COLUMNS && !header.iter().eq(undamped_header) {
+    // Tables from before the run columns are read without them, and tables from before
+    // the damping column as undamped.
+    let without_run = || {
+        SweepRow::COLUMNS
+            .iter()
+            .filter(|c| !SweepRow::RUN_COLUMNS.contains(c))
+    };
+    let undamped = || without_run().filter(|c| **c != "damping");
+    if header != SweepRow::COLUMNS
+        && !header.iter().eq(without_run())
+        && !header.iter().eq(undamped())
+    {
         return Err(Error::parse(
             &label,
             1,
@@ -239,6 +269,39 @@ pub fn common_damping(rows: &[SweepRow]) -> std::result::Result<f64, String> {
         )),
         None => Ok(first),
     }
+}
+
+/// Checks that the rows come from runs of one set-up: the same amplitude and duration,
+/// and per model the same time step and integrator (shards of one sweep share them; a
+/// shard run with another `--duration` or `--dt` would otherwise be merged without a
+/// word). Rows without the run columns (older tables) are not compared.
+pub fn common_run(rows: &[SweepRow]) -> std::result::Result<(), String> {
+    fn same<T: PartialEq + std::fmt::Debug>(
+        rows: &[SweepRow],
+        what: &str,
+        value: impl Fn(&SweepRow) -> Option<T>,
+    ) -> std::result::Result<(), String> {
+        let mut values = rows.iter().filter_map(|r| value(r).map(|v| (r, v)));
+        let Some((_, first)) = values.next() else {
+            return Ok(());
+        };
+        match values.find(|(_, v)| *v != first) {
+            Some((r, v)) => Err(format!(
+                "the rows mix runs of {what} {first:?} and {v:?} ({} α={} ρ={} Ω/ω={}); the \
+                 shards of one sweep share --amplitude-g, --duration, --dt and --integrator",
+                r.model, r.alpha, r.friction, r.freq_ratio
+            )),
+            None => Ok(()),
+        }
+    }
+    same(rows, "amplitude_g", |r| r.amplitude_g)?;
+    same(rows, "duration_s", |r| r.duration_s)?;
+    for model in ["dda", "mass-spring"] {
+        let of_model: Vec<SweepRow> = rows.iter().filter(|r| r.model == model).cloned().collect();
+        same(&of_model, "dt_s", |r| r.dt_s)?;
+        same(&of_model, "integrator", |r| r.integrator.clone())?;
+    }
+    Ok(())
 }
 
 /// " (ζ = 2 %)" for a damped sweep, "" for an undamped one: added to figure titles.
@@ -447,7 +510,33 @@ mod tests {
             steps: 1,
             wall_time_s: 0.0,
             energy_residual_rel: 0.0,
+            amplitude_g: Some(0.3),
+            duration_s: Some(100.0),
+            dt_s: (model == "dda").then_some(1e-3),
+            integrator: (model == "dda").then(|| "generalized-alpha:0.5".into()),
         }
+    }
+
+    #[test]
+    fn rows_of_other_run_set_ups_are_told_apart() {
+        let rows = vec![row("dda", 1.0, 1.0), row("mass-spring", 1.0, 1.0)];
+        assert_eq!(common_run(&rows), Ok(()));
+        for change in [
+            |r: &mut SweepRow| r.amplitude_g = Some(1.0),
+            |r: &mut SweepRow| r.duration_s = Some(5.0),
+            |r: &mut SweepRow| r.dt_s = Some(2e-3),
+            |r: &mut SweepRow| r.integrator = Some("trapezoidal".into()),
+        ] {
+            let mut other = row("dda", 2.0, 1.0);
+            change(&mut other);
+            let mut mixed = rows.clone();
+            mixed.push(other);
+            assert!(common_run(&mixed).is_err());
+        }
+        // An older table's rows (no run columns) are not compared.
+        let mut old = row("dda", 2.0, 1.0);
+        (old.amplitude_g, old.duration_s, old.dt_s, old.integrator) = (None, None, None, None);
+        assert_eq!(common_run(&[rows[0].clone(), old]), Ok(()));
     }
 
     #[test]
@@ -485,7 +574,7 @@ mod tests {
         let header: Vec<&str> = SweepRow::COLUMNS
             .iter()
             .copied()
-            .filter(|c| *c != "damping")
+            .filter(|c| *c != "damping" && !SweepRow::RUN_COLUMNS.contains(c))
             .collect();
         std::fs::write(
             &old,
@@ -498,6 +587,7 @@ mod tests {
         let rows = read_sweep_csv(&old).unwrap();
         assert_eq!(rows.len(), 1);
         assert_eq!(rows[0].damping, 0.0);
+        assert_eq!(rows[0].duration_s, None);
         let new = dir.join("new.csv");
         let mut damped = row("dda", 2.0, 1.0);
         damped.damping = 0.05;
