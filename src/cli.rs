@@ -469,7 +469,11 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     }));
     if let Some(dir) = &args.out {
         // A bad folder is reported now, not after the run.
-        slidebase::post::output::prepare_dir(dir)?;
+        slidebase::post::output::prepare_outputs(
+            dir,
+            "--out",
+            &slidebase::headless::run::OUTPUT_FILES,
+        )?;
         setup.history = if setup.two_block().is_some() {
             OUTPUT_HISTORY
         } else {
@@ -493,7 +497,7 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     warn(&s.warnings);
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
     out(&format!(
-        "{} ({}), α = {}, {}, {}{}, {:.1} s",
+        "{} ({}), α = {}, {}, {}{}, {} s",
         s.scene,
         s.model,
         s.alpha,
@@ -508,7 +512,7 @@ fn cmd_run(args: RunArgs) -> Result<()> {
                 .map_or(String::new(), |r| format!(" Ω/ω = {r:.4}")),
             s.vertical_record.as_deref()
         ),
-        s.duration_s
+        seconds(s.duration_s)
     ))?;
     out(&format!(
         "  |u_s|max/D        {}   ({:.4e} m)",
@@ -572,7 +576,7 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
     let threads = jobs(args.jobs)?;
     // Every value and the output folder are checked before the first run.
     req.validate()?;
-    slidebase::post::output::prepare_dir(&args.out)?;
+    slidebase::post::output::prepare_outputs(&args.out, "--out", &["sweep.csv", "errors.md"])?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
@@ -739,6 +743,13 @@ fn list_written(files: Vec<std::path::PathBuf>, json: bool) -> Result<()> {
     Ok(())
 }
 
+/// A duration in a header: to the microsecond, without trailing zeros (a 1.5 ms run is
+/// not "0.0 s", and 31.18 s is not 31.179999999999996).
+fn seconds(t: f64) -> String {
+    let text = format!("{t:.6}");
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// The first line of a building or block run's text summary.
 fn run_header(
     scene: &str,
@@ -750,7 +761,10 @@ fn run_header(
 ) -> String {
     let integrator = integrator.map_or(String::new(), |i| format!(", {i}"));
     let friction = friction.unwrap_or_else(|| "fixed base".into());
-    format!("{scene} ({model}{integrator}), {record}, {friction}, {duration_s:.2} s")
+    format!(
+        "{scene} ({model}{integrator}), {record}, {friction}, {} s",
+        seconds(duration_s)
+    )
 }
 
 /// The horizontal excitation's label with the vertical record's, if the run has one (so

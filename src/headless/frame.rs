@@ -168,6 +168,7 @@ fn summarise(
     base_accel: Option<UniformSeries>,
 ) -> Result<FrameSummary> {
     let mut warnings = setup.warnings.clone();
+    warnings.extend(run.lift_off_warning(setup.vertical.is_some()));
     let peak_freq = base_accel.and_then(|series| {
         let (samples, dt) = series.finish();
         let peak = fourier_amplitude(&samples, dt)

@@ -131,6 +131,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         a_max / (big_omega * big_omega)
     });
     let mut warnings = setup.warnings.clone();
+    warnings.extend(run.lift_off_warning(setup.vertical.is_some()));
     if a_max <= 0.0 {
         warnings.push(format!(
             "the ground does not accelerate in the first {duration} s: the ratios to its \
@@ -255,6 +256,10 @@ pub fn standard_overlays(setup: &RunSetup) -> Result<Vec<SlipOverlay>> {
     }
     Ok(overlays)
 }
+
+/// Every file a `run --out` may write (the two-block, building and block runs' together),
+/// checked before the run: a folder of one of these names would fail only at the end.
+pub const OUTPUT_FILES: [&str; 4] = ["history.csv", "summary.json", "history.png", "friction.png"];
 
 /// Writes a run's histories and summary into `dir`; its figure draws `overlays` over the
 /// run's slip and roof drift.

@@ -69,6 +69,24 @@ pub struct ModelRun {
     /// Peaks of the absolute base and roof accelerations low-passed at 25 Hz (DDA only,
     /// and only when the run is long enough to filter; see [`crate::post::filter`]).
     pub low_passed: Option<LowPassedPeaks>,
+    /// When the base first lifted off the ground at a corner (DDA only, and only for a
+    /// structure whose only contacts are its sliding joint's: fewer of them closed than
+    /// at the first step), s. The exact models keep the base flat on the ground.
+    pub lift_off_time_s: Option<f64>,
+}
+
+impl ModelRun {
+    /// The warning a run's summary carries when its base lifted off at a corner (not for
+    /// vertical shaking, whose lift-off is warned of before the run).
+    pub fn lift_off_warning(&self, vertical: bool) -> Option<String> {
+        let t = self.lift_off_time_s.filter(|_| !vertical)?;
+        Some(format!(
+            "the base lifted off the ground at a corner at t = {t:.3} s: the structure rocks \
+             (its overturning moment exceeded the weight's restoring moment), so the slip \
+             and accelerations include rocking, which the exact model does not have; lower \
+             the friction or the shaking to stay within sliding"
+        ))
+    }
 }
 
 /// Peaks of accelerations low-passed at [`crate::post::filter::CUTOFF_HZ`], m/s².
@@ -117,6 +135,11 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
     // (one that stopped a few steps short made comparisons of histories clamp there).
     let mut unrecorded = None;
     let mut sliding_steps = 0;
+    // A corner of the base lifting off: fewer closed contacts than at the first step,
+    // where the sliding joint's are the only contacts (a wall's own open and close).
+    let joint_only = scene.contacts.iter().all(|c| c.name == setup.joint);
+    let mut closed_at_start = None;
+    let mut lift_off_time_s = None;
     let mut next_report = setup.progress.as_ref().map(|p| p.first_after_s);
     // Built at the first report: a run that never reports never samples its motion.
     let mut remaining: Option<RemainingTime> = None;
@@ -144,6 +167,12 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         }
         if report.sliding > 0 {
             sliding_steps += 1;
+        }
+        if joint_only && lift_off_time_s.is_none() {
+            let start = *closed_at_start.get_or_insert(report.closed);
+            if report.closed < start {
+                lift_off_time_s = Some(report.time);
+            }
         }
         let r = probe.measure(d, Some(motion));
         let row = [
@@ -213,6 +242,7 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         history,
         base_accel_series: Some(series),
         low_passed,
+        lift_off_time_s,
     })
 }
 
@@ -322,6 +352,7 @@ impl ModelRun {
             history,
             base_accel_series: None,
             low_passed: None,
+            lift_off_time_s: None,
         }
     }
 }

@@ -60,8 +60,14 @@ fn dish_sag(rd: f64) -> f64 {
 /// The friction pendulum of effective radius `radius` (m), named `friction-pendulum` (or
 /// `friction-pendulum:R` off the default radius).
 pub fn friction_pendulum(radius: f64) -> Result<Scene> {
+    pendulum_of_radius(radius, "--radius")
+}
+
+/// [`friction_pendulum`], its radius given by `field` (the flag or the scene's spelling,
+/// which an out-of-range radius is reported against).
+fn pendulum_of_radius(radius: f64, field: &str) -> Result<Scene> {
     let (lo, hi) = RADIUS_RANGE_M;
-    crate::error::require_range("--radius", radius, lo, hi, "m (the effective radius R)")?;
+    crate::error::require_range(field, radius, lo, hi, "m (the effective radius R)")?;
     let dish_radius = dish_radius_for(radius)?;
     let name = if radius == DEFAULT_RADIUS_M {
         NAME.to_string()
@@ -156,7 +162,7 @@ pub fn resolve(name: &str) -> Option<Result<Scene>> {
                     format!("'{name}': the radius after ':' must be a number of metres"),
                 )
             })
-            .and_then(friction_pendulum),
+            .and_then(|r| pendulum_of_radius(r, "--scene friction-pendulum:R")),
     )
 }
 

@@ -8,6 +8,26 @@ use super::scene::{ExcitationDef, Scene};
 use crate::{Error, Result};
 
 /// The built-in scenes: (name, TOML text).
+/// The smallest mass ratio α = m/(M + m) taken: below it the roof's density falls under
+/// the smallest a material may have (a millionth of the mass is already a weightless roof).
+pub const MIN_ALPHA: f64 = 1e-6;
+
+/// Checks a two-block mass ratio α: in [[`MIN_ALPHA`], 1) (the top end is bounded by Δt,
+/// which must resolve the slip phase's period, shorter as α → 1).
+pub fn check_alpha(alpha: f64) -> Result<()> {
+    if alpha.is_finite() && (MIN_ALPHA..1.0).contains(&alpha) {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        "--alpha",
+        format!(
+            "the mass ratio m/(M + m) must be in [{MIN_ALPHA:e}, 1), got {} (below \
+             {MIN_ALPHA:e} the roof would be lighter than any material taken)",
+            crate::error::show(alpha)
+        ),
+    ))
+}
+
 const BUILTIN: &[(&str, &str)] = &[
     (
         "two-block",
@@ -68,15 +88,7 @@ pub struct TwoBlockParams {
 impl TwoBlockParams {
     /// Checks the ranges with the command-line names in the messages.
     pub fn validate(&self) -> Result<()> {
-        if !(self.alpha > 0.0 && self.alpha < 1.0) {
-            return Err(Error::invalid(
-                "--alpha",
-                format!(
-                    "the mass ratio m/(M+m) must be in (0, 1), got {}",
-                    self.alpha
-                ),
-            ));
-        }
+        check_alpha(self.alpha)?;
         if self.friction.is_nan() || self.friction < 0.0 {
             return Err(Error::invalid(
                 "--friction",

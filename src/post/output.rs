@@ -31,6 +31,19 @@ pub fn prepare_dir_for(dir: &Path, flag: &str) -> Result<()> {
     Ok(())
 }
 
+/// [`prepare_dir_for`], and none of the files `names` the work will write into `dir` is a
+/// folder there (it could not be replaced, and the run would fail only at its end).
+pub fn prepare_outputs(dir: &Path, flag: &str, names: &[&str]) -> Result<()> {
+    prepare_dir_for(dir, flag)?;
+    match names.iter().map(|n| dir.join(n)).find(|p| p.is_dir()) {
+        Some(blocked) => Err(Error::output(
+            &blocked,
+            format!("is a folder; {flag} names a folder whose output files would replace it"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Makes sure the file `path` (named by `flag`) can be written: its folder is (or can be
 /// made) a writable folder and the path itself is not a folder. Checked before the work
 /// that produces the file, as [`prepare_dir`] is.

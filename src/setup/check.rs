@@ -21,16 +21,8 @@ pub(super) fn check_ranges(spec: &RunSpec) -> Result<()> {
     if let Some(d) = spec.duration {
         crate::error::require_positive("--duration", d)?;
     }
-    if let Some(a) = spec.alpha
-        && !(a > 0.0 && a < 1.0)
-    {
-        return Err(Error::invalid(
-            "--alpha",
-            format!(
-                "the mass ratio m/(M + m) must be in (0, 1), got {}",
-                show(a)
-            ),
-        ));
+    if let Some(a) = spec.alpha {
+        crate::model::presets::check_alpha(a)?;
     }
     if spec.friction.is_some() && spec.friction_law.is_some() {
         return Err(Error::invalid(
@@ -349,10 +341,11 @@ fn check_vertical(
         ));
     }
     if let Some((t, a)) = first_lift_off(vertical, setup.scene.gravity, setup.duration) {
+        let g = crate::ground_motion::STANDARD_GRAVITY;
         let what = format!(
-            "the vertical ground acceleration reaches {:.3} g downward at t = {t:.3} s, more \
-             than gravity: the structure lifts off the ground there",
-            -a / crate::ground_motion::STANDARD_GRAVITY
+            "the vertical ground acceleration passes gravity downward at t = {t:.3} s \
+             (reaching {} g): the structure lifts off the ground there",
+            above_in_print(-a / g, setup.scene.gravity / g)
         );
         if setup.model == ModelKind::MassSpring {
             return Err(Error::invalid(
@@ -368,8 +361,8 @@ fn check_vertical(
 }
 
 /// The first time in [0, duration] when the ground accelerates downward faster than
-/// gravity (g + a_v ≤ 0), and a_v then; records are piecewise linear, so their samples
-/// bound it.
+/// gravity (g + a_v ≤ 0), and a_v at the sample where it has (the crossing itself is
+/// exactly −g); records are piecewise linear, so their samples bound it.
 fn first_lift_off(vertical: &GroundMotion, gravity: f64, duration: f64) -> Option<(f64, f64)> {
     let times: Vec<f64> = std::iter::once(0.0)
         .chain(vertical.breakpoints(0.0, duration))
@@ -383,7 +376,7 @@ fn first_lift_off(vertical: &GroundMotion, gravity: f64, duration: f64) -> Optio
         // Linear in between: where it crosses −g.
         (gravity + a1 <= 0.0).then(|| {
             let t = w[0] + (w[1] - w[0]) * (gravity + a0) / (a0 - a1);
-            (t, -gravity)
+            (t, a1)
         })
     })
 }
@@ -444,4 +437,22 @@ fn resolution(setup: &RunSetup, warnings: &mut Vec<String>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `value` printed with three decimals, or as many more (up to nine) as show it above
+/// `limit`: a record peaking at 1.0004 g is not said to reach "1.000 g, more than gravity".
+fn above_in_print(value: f64, limit: f64) -> String {
+    let shown = |d: usize| format!("{value:.d$}");
+    let exceeds = |d: usize| shown(d).parse::<f64>().is_ok_and(|v| v > limit);
+    shown((3..=9).find(|&d| exceeds(d)).unwrap_or(9))
+}
+
+#[cfg(test)]
+mod tests {
+    /// A peak just above gravity is printed above it, a clear one with three decimals.
+    #[test]
+    fn a_value_just_above_its_limit_is_printed_above_it() {
+        assert_eq!(super::above_in_print(1.0004, 1.0), "1.0004");
+        assert_eq!(super::above_in_print(1.5, 1.0), "1.500");
+    }
 }
