@@ -178,11 +178,10 @@ struct Stepping {
 impl Stepping {
     /// The integrator, parsed.
     fn integrator(&self) -> Result<Option<Integrator>> {
-        Ok(self
-            .integrator
+        self.integrator
             .as_deref()
-            .map(Integrator::parse)
-            .transpose()?)
+            .map(|text| Integrator::parse(text).with_context(|| format!("--integrator {text}")))
+            .transpose()
     }
 }
 
@@ -249,7 +248,7 @@ struct RenderArgs {
     height: Option<u32>,
     /// Deformation exaggeration factor (default: automatic, as in the window).
     #[arg(long, allow_hyphen_values = true)]
-    exaggeration: Option<f32>,
+    exaggeration: Option<f64>,
     /// Only the sliding model (no fixed-base panel beside it).
     #[arg(long)]
     single: bool,
@@ -467,6 +466,9 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     setup.progress = Some(slidebase::setup::ProgressReporter::new(5.0, 5.0, |p| {
         eprintln!("run: {p}");
     }));
+    // The set-up's warnings (a ground too fast for the step, a coarse Δt…) come before the
+    // run, which they may make long; the summary (and the JSON) carries them too.
+    warn(&setup.warnings);
     if let Some(dir) = &args.out {
         // A bad folder is reported now, not after the run.
         slidebase::post::output::prepare_outputs(
@@ -494,7 +496,7 @@ fn cmd_run(args: RunArgs) -> Result<()> {
     if args.json {
         return out(&serde_json::to_string(s)?);
     }
-    warn(&s.warnings);
+    warn_after_run(&s.warnings, &setup.warnings);
     let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
     out(&format!(
         "{} ({}), α = {}, {}, {}{}, {} s",
@@ -783,6 +785,16 @@ fn warn(warnings: &[String]) {
     }
 }
 
+/// The warnings of a finished run that were not already printed before it (those of its
+/// set-up, see [`cmd_run`]).
+fn warn_after_run(warnings: &[String], before: &[String]) {
+    let fresh: Vec<String> = (warnings.iter())
+        .filter(|w| !before.contains(w))
+        .cloned()
+        .collect();
+    warn(&fresh);
+}
+
 fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<()> {
     let outcome = slidebase::headless::frame::run_building_setup(setup)?;
     if let Some(dir) = &args.out {
@@ -795,7 +807,7 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     if args.json {
         return out(&serde_json::to_string(s)?);
     }
-    warn(&s.warnings);
+    warn_after_run(&s.warnings, &setup.warnings);
     let friction = match (&s.friction_law, s.friction) {
         (Some(law), _) => Some(format!("friction {law}")),
         (None, f) => f.map(|f| format!("ρ = {f}")),
@@ -865,7 +877,7 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
     if args.json {
         return out(&serde_json::to_string(s)?);
     }
-    warn(&s.warnings);
+    warn_after_run(&s.warnings, &setup.warnings);
     let friction = s.friction_law.as_ref().map(|f| format!("friction {f}"));
     out(&run_header(
         &s.scene,
@@ -902,10 +914,9 @@ fn check_picture(args: &RenderArgs) -> Result<Option<slidebase::post::output::Vi
             bail!("invalid {flag}: {v} pixels; give {MIN_IMAGE_SIDE} to {MAX_IMAGE_SIDE}");
         }
     }
-    if let Some(f) = args.exaggeration
-        && !(f.is_finite() && f > 0.0)
-    {
-        bail!("invalid --exaggeration: {f}; give a finite factor > 0 (1: true scale)");
+    if let Some(f) = args.exaggeration {
+        let (lo, hi) = slidebase::limits::EXAGGERATION_RANGE;
+        slidebase::error::require_range("--exaggeration", f, lo, hi, "(1: true scale)")?;
     }
     Ok(video)
 }
@@ -935,7 +946,8 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     let options = PictureOptions {
         width: args.width.unwrap_or(default_size.0),
         height: args.height.unwrap_or(default_size.1),
-        exaggeration: args.exaggeration,
+        // In range (checked above), so single precision holds it.
+        exaggeration: args.exaggeration.map(|f| f as f32),
         close_ups: !args.no_close_ups,
     };
     let info = match video {

@@ -40,7 +40,7 @@ pub enum Error {
 
     /// A ground-motion record (file or built-in) that is malformed or outside the range a
     /// run can use.
-    #[error("record {file}:{line}: {message}")]
+    #[error("record {file}{}: {message}", at_line(*line))]
     Record {
         /// The file (or `<built-in NAME>`).
         file: String,
@@ -51,7 +51,7 @@ pub enum Error {
     },
 
     /// A file (scene TOML, sweep table) was read but its contents are malformed.
-    #[error("{file}:{line}: {message}")]
+    #[error("{file}{}: {message}", at_line(*line))]
     Parse {
         /// The file (or a label such as `<built-in el-centro>`).
         file: String,
@@ -117,6 +117,19 @@ impl Error {
         }
     }
 
+    /// A record's error placed in `file` (the path a reader was given, where the record's
+    /// own checks know only its name); other errors unchanged.
+    pub fn in_file(self, file: &str) -> Self {
+        match self {
+            Error::Record { line, message, .. } => Error::Record {
+                file: file.into(),
+                line,
+                message,
+            },
+            other => other,
+        }
+    }
+
     /// Shorthand for [`Error::Record`].
     pub fn record(file: impl Into<String>, line: usize, message: impl Into<String>) -> Self {
         Error::Record {
@@ -162,6 +175,15 @@ pub fn show(x: f64) -> String {
         format!("{x}")
     } else {
         format!("{x:e}")
+    }
+}
+
+/// `:LINE` after a file's name, or nothing for line 0 (a problem of the whole file).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
     }
 }
 

@@ -106,13 +106,9 @@ fn check_options(options: &PictureOptions) -> Result<()> {
             ));
         }
     }
-    if let Some(f) = options.exaggeration
-        && !(f.is_finite() && f > 0.0)
-    {
-        return Err(Error::invalid(
-            "--exaggeration",
-            format!("must be > 0, got {f}"),
-        ));
+    if let Some(f) = options.exaggeration {
+        let (lo, hi) = crate::limits::EXAGGERATION_RANGE;
+        crate::error::require_range("--exaggeration", f64::from(f), lo, hi, "(1: true scale)")?;
     }
     Ok(())
 }

@@ -152,3 +152,8 @@ pub fn read_text(path: &std::path::Path, max_bytes: u64, what: &str) -> crate::R
         )
     })
 }
+
+/// The deformation exaggeration a picture or replay may be drawn with (1: true scale; the
+/// automatic choice lies in 1…1000). Beyond it the drift leaves the picture and the
+/// single-precision vertices lose the shape.
+pub const EXAGGERATION_RANGE: (f64, f64) = (0.01, 1e4);

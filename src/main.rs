@@ -19,8 +19,63 @@ fn main() -> ExitCode {
                     message.push_str(&cause);
                 }
             }
-            eprintln!("error: {message}");
+            eprintln!("error: {}", shorten_long_words(&message));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The longest word an error message echoes whole, in characters.
+const MAX_ECHOED_CHARS: usize = 120;
+
+/// `message` with every word (run of non-blank characters) longer than
+/// [`MAX_ECHOED_CHARS`] cut to its start and end around its length: an error that quotes
+/// a 10 MB `--scene` value, or a 300-digit number, stays a line a person can read.
+fn shorten_long_words(message: &str) -> String {
+    let mut shortened = String::with_capacity(message.len().min(4096));
+    let mut rest = message;
+    while !rest.is_empty() {
+        let word_len = rest.find(char::is_whitespace).unwrap_or(rest.len());
+        let (word, after) = rest.split_at(word_len);
+        shortened.push_str(&shorten_word(word));
+        let blank_len = after
+            .find(|c: char| !c.is_whitespace())
+            .unwrap_or(after.len());
+        shortened.push_str(&after[..blank_len]);
+        rest = &after[blank_len..];
+    }
+    shortened
+}
+
+/// One word cut as [`shorten_long_words`] says (whole if short enough).
+fn shorten_word(word: &str) -> String {
+    let count = word.chars().count();
+    if count <= MAX_ECHOED_CHARS {
+        return word.to_string();
+    }
+    let head: String = word.chars().take(60).collect();
+    let tail: String = word.chars().skip(count - 20).collect();
+    format!("{head}…[{count} characters]…{tail}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A long word is cut to 60 + 20 characters around its length; short ones, blanks and
+    /// multi-byte characters are kept as they are.
+    #[test]
+    fn long_words_are_cut_and_the_rest_kept() {
+        let long = "é".repeat(1000);
+        let cut = shorten_long_words(&format!("bad  '{long}': give  Δt"));
+        assert_eq!(
+            cut,
+            format!(
+                "bad  '{}…[1003 characters]…{} give  Δt",
+                "é".repeat(59),
+                "é".repeat(18) + "':"
+            )
+        );
+        assert_eq!(shorten_long_words("a b\nc"), "a b\nc");
     }
 }

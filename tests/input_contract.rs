@@ -1214,3 +1214,83 @@ fn errors_name_the_flag_the_user_gave() {
     assert_eq!(code, 1, "{err}");
     assert_has(&err, &["--scene friction-pendulum:R", "[0.5, 20]"]);
 }
+
+/// A ground so fast that a base dragged along by it would cross the step limit in one Δt
+/// (20 g at Ω/ω = 0.2: the ground reaches 2A/Ω ≈ 312 m/s, ~0.1 of the two-block's size per
+/// millisecond against a limit of 0.01) is said before the run, with the step it will
+/// take; the paper's 0.3 g at the same ratio (0.15 % of the size per step) is not.
+#[test]
+fn a_ground_too_fast_for_the_step_is_warned_of_before_the_run() {
+    let warned = |amplitude_g: f64| {
+        RunSpec {
+            excitation: harmonic(Some(amplitude_g), Some(0.2)),
+            ..RunSpec::default()
+        }
+        .prepare()
+        .unwrap()
+        .warnings
+        .iter()
+        .any(|w| w.contains("ground reaches") && w.contains("steps are cut to about"))
+    };
+    assert!(warned(20.0));
+    assert!(!warned(0.3));
+}
+
+/// An exaggeration beyond single precision is refused as given (it was read as f32 and
+/// reported as "inf"); a 100 000-character scene name is echoed cut to a readable word.
+#[test]
+fn huge_values_are_reported_as_given_and_long_ones_cut() {
+    let (code, _, err) = cli(&[
+        "render",
+        "--exaggeration",
+        "1e300",
+        "--time",
+        "1",
+        "--out",
+        "x.png",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert_has(&err, &["--exaggeration", "[0.01, 10000]", "got 1e300"]);
+    let (code, _, err) = cli(&["run", "--scene", &"x".repeat(100_000)]);
+    assert_eq!(code, 1, "{err}");
+    assert_has(&err, &["unknown scene", "[100002 characters]", "known:"]);
+    assert!(err.len() < 1000, "{} bytes", err.len());
+}
+
+/// A bad value in a sweep table is reported by its column and the value found, at its
+/// line also in a table written with CRLF row ends (a spreadsheet's, Python's csv).
+#[test]
+fn a_bad_sweep_cell_is_named_by_column_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("s.csv");
+    let header = SweepRow::COLUMNS.join(",");
+    let row = "mass-spring,0.5,0.1,x,0.0,3.4,1.1,0.96,1.13,93,0.0002,0.0,0.3,2.0,,";
+    std::fs::write(&path, format!("{header}\r\n{row}\r\n")).unwrap();
+    let err = read_sweep_csv(&path).unwrap_err().to_string();
+    assert_has(&err, &["s.csv:2", "column 'freq_ratio'", "got 'x'"]);
+}
+
+/// A ground that moves 20 g at Ω/ω = 0.002 for 300 s: its steps, cut to follow the base
+/// it drags (~1 µs), would pass the step limit, and confirmed, its travel (5.4e6 m) would
+/// pass the largest coordinate — each said against the flags, not as a bad vertex of the
+/// ground block the command line lengthens.
+#[test]
+fn a_ground_that_travels_beyond_the_scene_limits_is_refused_by_its_flags() {
+    let spec = |confirm_large| RunSpec {
+        excitation: harmonic(Some(20.0), Some(0.002)),
+        duration: Some(300.0),
+        confirm_large,
+        ..RunSpec::default()
+    };
+    let err = spec_error(spec(false));
+    assert_has(
+        &err,
+        &["--freq-ratio", "steps would be cut", "--confirm-large"],
+    );
+    let err = spec_error(spec(true));
+    assert_has(
+        &err,
+        &["ground would move up to 5.4", "±1e6 m", "--amplitude-g"],
+    );
+    assert!(!err.contains("vertices"), "{err}");
+}

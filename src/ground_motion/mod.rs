@@ -123,6 +123,18 @@ impl GroundMotion {
         }
     }
 
+    /// Largest |ground velocity| (from rest) over [0, `until`], m/s (a record's at its
+    /// samples).
+    pub fn peak_velocity(&self, until: f64) -> f64 {
+        match self {
+            // A/Ω (1 − cos Ωt) grows until Ωt = π.
+            GroundMotion::Harmonic(h) => h
+                .velocity(until.min(std::f64::consts::PI / h.omega.abs()))
+                .abs(),
+            GroundMotion::Record(r) => r.peak_velocity(until),
+        }
+    }
+
     /// Times in the open interval `(t0, t1)` where the acceleration has a kink (record
     /// samples). Exact integrators step onto these so that the forcing is smooth in between.
     pub fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {

@@ -217,7 +217,10 @@ pub fn parse_at2(text: &str, file_label: &str, name: &str) -> Result<Record> {
         .map(|l| l.trim())
         .collect::<Vec<_>>()
         .join(" / ");
-    Ok(Record::new(name, dt, values)?.with_provenance(provenance))
+    Ok(Record::new(name, dt, values)
+        .map_err(|e| e.in_file(file_label))?
+        .with_provenance(provenance)
+        .with_source(file_label))
 }
 
 /// A header row: every field a word (a column name), none a number — so that a number
@@ -376,7 +379,10 @@ pub fn parse_text(text: &str, file_label: &str, name: &str) -> Result<Record> {
             ));
         }
     }
-    Ok(Record::new(name, dt, accel)?.with_provenance(comments.join("\n")))
+    Ok(Record::new(name, dt, accel)
+        .map_err(|e| e.in_file(file_label))?
+        .with_provenance(comments.join("\n"))
+        .with_source(file_label))
 }
 
 /// Reads a record file: AT2 when the extension is `.at2` (any case) or the fourth line

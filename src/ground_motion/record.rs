@@ -15,6 +15,9 @@ pub struct Record {
     pub name: String,
     /// Where the data came from (event, station, component, source package), for reports.
     pub provenance: String,
+    /// Where it was read: the file's path as given (its name for a built-in record);
+    /// errors about the whole record point there.
+    pub source: String,
     /// Sample spacing, s.
     pub dt: f64,
     /// Acceleration samples at t = k·dt, m/s².
@@ -73,6 +76,7 @@ impl Record {
             disp[k] = disp[k - 1] + dt * vel[k - 1] + dt * dt * (2.0 * a0 + a1) / 6.0;
         }
         Ok(Self {
+            source: name.clone(),
             name,
             provenance: String::new(),
             dt,
@@ -88,11 +92,19 @@ impl Record {
         self
     }
 
+    /// Records where the record was read (see [`Record::source`]).
+    pub fn with_source(mut self, source: impl Into<String>) -> Self {
+        self.source = source.into();
+        self
+    }
+
     /// Multiplies every sample by `factor` (e.g. to scale a record to a target PGA).
     pub fn scaled(&self, factor: f64) -> Result<Self> {
         crate::error::require_positive("record scale factor", factor)?;
         let accel = self.accel.iter().map(|a| a * factor).collect();
-        Ok(Self::new(self.name.clone(), self.dt, accel)?.with_provenance(self.provenance.clone()))
+        Ok(Self::new(self.name.clone(), self.dt, accel)?
+            .with_provenance(self.provenance.clone())
+            .with_source(self.source.clone()))
     }
 
     /// Whether the record says it is a vertical component: a `component:` note naming it
@@ -200,6 +212,14 @@ impl Record {
         self.accel[..=last]
             .iter()
             .fold(0.0_f64, |m, a| m.max(a.abs()))
+    }
+
+    /// Largest |v| (from rest) over samples with t ≤ `until`, m/s.
+    pub fn peak_velocity(&self, until: f64) -> f64 {
+        let last = ((until / self.dt).floor() as usize).min(self.vel.len() - 1);
+        self.vel[..=last]
+            .iter()
+            .fold(0.0_f64, |m, v| m.max(v.abs()))
     }
 
     /// Sample times strictly inside `(t0, t1)`.

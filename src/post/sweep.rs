@@ -165,6 +165,23 @@ pub fn write_sweep_csv(path: &Path, rows: &[SweepRow]) -> Result<()> {
     w.flush().map_err(|e| Error::io(path, e))
 }
 
+/// A row's deserialisation error named by its column and the value found there (the CSV
+/// reader's own says "field 2").
+fn field_error(e: &csv::Error, headers: &csv::StringRecord, rec: &csv::StringRecord) -> String {
+    let csv::ErrorKind::Deserialize { err, .. } = e.kind() else {
+        return e.to_string();
+    };
+    match err.field().map(|i| i as usize) {
+        Some(i) => format!(
+            "column '{}': {} (got '{}')",
+            headers.get(i).unwrap_or("?"),
+            err.kind(),
+            rec.get(i).unwrap_or("")
+        ),
+        None => err.to_string(),
+    }
+}
+
 /// Reads a sweep CSV and checks every row (known model, α in (0, 1), finite ρ ≥ 0 and
 /// Ω/ω > 0, finite non-negative metrics); errors name the file and line. A table with
 /// only its header (an empty shard) has no rows; a file without the header is refused.
@@ -172,6 +189,9 @@ pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
     let text = crate::limits::read_text(path, crate::limits::MAX_TABLE_FILE_BYTES, "sweep table")?;
     let label = path.display().to_string();
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    // The reader counts a CRLF row's line wrongly (a spreadsheet's or Python's table was
+    // reported at line 1 for its second row): read every row ending as a newline.
+    let text = text.replace("\r\n", "\n");
     let mut r = csv::Reader::from_reader(text.as_bytes());
     let header: Vec<String> = r
         .headers()
@@ -211,7 +231,7 @@ pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
         let line = rec.position().map_or(0, |p| p.line() as usize);
         let row: SweepRow = rec
             .deserialize(Some(&headers))
-            .map_err(|e| Error::parse(&label, line, e.to_string()))?;
+            .map_err(|e| Error::parse(&label, line, field_error(&e, &headers, &rec)))?;
         row.check().map_err(|m| Error::parse(&label, line, m))?;
         rows.push(row);
     }

@@ -280,7 +280,7 @@ pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<Strin
         let peak = r.peak_accel(r.duration());
         if peak < MIN_AMPLITUDE_G * crate::ground_motion::STANDARD_GRAVITY {
             return Err(Error::record(
-                &r.name,
+                &r.source,
                 0,
                 format!(
                     "its largest acceleration is {:.3e} g, below {MIN_AMPLITUDE_G:e} g: no \
@@ -307,6 +307,7 @@ pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<Strin
                 ));
             }
             resolution(setup, &mut warnings)?;
+            warnings.extend(fast_ground(setup, confirmed)?);
         }
         ModelKind::MassSpring => {
             if let Some(steps) = exact_steps(setup) {
@@ -315,6 +316,49 @@ pub(super) fn check_setup(setup: &RunSetup, confirmed: bool) -> Result<Vec<Strin
         }
     }
     Ok(warnings)
+}
+
+/// A ground so fast that a base it drags along would move further in one Δt than the
+/// solver lets a vertex move in a step (`max_displacement_ratio` of the structure's size):
+/// every such step is cut, and a run asked for in 1e5 steps takes millions. Said before
+/// the run, with the step it will take; refused (unless confirmed) when those steps would
+/// pass [`MAX_STEPS`], as a run asked for in that many steps is.
+fn fast_ground(setup: &RunSetup, confirmed: bool) -> Result<Option<String>> {
+    if setup.fixed_base || setup.friction.is_infinite() {
+        return Ok(None);
+    }
+    let structure: Vec<[f64; 2]> = (setup.scene.blocks.iter())
+        .filter(|b| b.name != setup.scene.ground.block)
+        .flat_map(|b| b.vertices.iter().copied())
+        .collect();
+    let size = crate::model::geometry::bounding_size(&structure);
+    let ratio = setup.solver_params().max_displacement_ratio;
+    let speed = setup.motion.peak_velocity(setup.duration);
+    let step = ratio * size / speed;
+    let steps = setup.duration / step;
+    if step < setup.dt && steps > MAX_STEPS && !confirmed {
+        return Err(Error::invalid(
+            "--amplitude-g/--freq-ratio/--duration",
+            format!(
+                "the ground reaches {speed:.3e} m/s, so the run's steps would be cut to about \
+                 {step:.2e} s to follow a base it drags along: {steps:.2e} steps, beyond the \
+                 limit of {MAX_STEPS:e}; lower the amplitude, raise the frequency, shorten \
+                 --duration, or give --confirm-large to run it anyway"
+            ),
+        ));
+    }
+    Ok((step < setup.dt).then(|| {
+        format!(
+            "the ground reaches {speed:.3e} m/s: a base it drags along would move {:.3} of \
+             the structure's size in one Δt = {} s, beyond the step limit of {ratio}, so \
+             steps are cut to about {step:.2e} s (up to {:.1e} steps instead of {:.1e}); \
+             lower the amplitude or raise the frequency for a run of the asked length",
+            speed * setup.dt / size,
+            show(setup.dt),
+            steps,
+            setup.duration / setup.dt,
+        )
+    }))
 }
 
 /// Vertical shaking: where it applies, whether its record is a vertical one, and when it

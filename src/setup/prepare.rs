@@ -124,10 +124,8 @@ impl RunSpec {
         // A sliding base travels at most as far as the ground moves: make sure the ground
         // block is long enough.
         let travel = max_abs_displacement(&setup.motion, setup.duration);
-        extend_ground(
-            &mut setup.scene,
-            defaults::GROUND_TRAVEL_FACTOR * travel + defaults::GROUND_MARGIN_M,
-        )?;
+        let half_length = defaults::GROUND_TRAVEL_FACTOR * travel + defaults::GROUND_MARGIN_M;
+        extend_ground(&mut setup.scene, half_length)?;
         if self.fixed_base {
             for c in setup.scene.contacts.iter_mut() {
                 if c.name == setup.joint {
@@ -141,6 +139,8 @@ impl RunSpec {
         self.check_dish_on_large_mass(&setup.scene)?;
         setup.vertical = self.vertical_motion(&setup.scene)?;
         setup.warnings = check::check_setup(&setup, self.confirm_large)?;
+        // After the step count: a run too long to compute is told so first.
+        check_ground_travel(half_length, travel, setup.duration)?;
         Ok(setup)
     }
 
@@ -483,6 +483,28 @@ impl RunSpec {
     }
 }
 
+/// Refuses a ground motion that travels so far that the ground block, lengthened to
+/// `half_length` each side, would pass the largest coordinate a scene may have (it was
+/// reported as a bad vertex of a block the user never wrote).
+fn check_ground_travel(half_length: f64, travel: f64, duration: f64) -> Result<()> {
+    // A margin for the structure's own offset from the origin.
+    let limit = 0.99 * crate::limits::MAX_COORDINATE_M;
+    if half_length <= limit {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        "ground motion",
+        format!(
+            "the ground would move up to {travel:.3e} m in {} s, and the ground \
+             block under a sliding base would have to reach beyond ±{:e} m, the largest \
+             coordinate a scene may have: lower the amplitude (--amplitude-g, --pga), raise \
+             the frequency (--freq-ratio) or shorten --duration",
+            crate::error::show(duration),
+            crate::limits::MAX_COORDINATE_M
+        ),
+    ))
+}
+
 impl RunSetup {
     /// The solver parameters of the run (the solver's own defaults otherwise).
     pub fn solver_params(&self) -> SolverParams {
@@ -584,7 +606,7 @@ impl RunSetup {
     /// (a side-by-side comparison of friction values).
     pub fn friction_variant_scene(&self, friction: f64) -> Result<Scene> {
         crate::error::require_range(
-            "comparison friction",
+            "--compare-friction",
             friction,
             0.0,
             crate::limits::MAX_FRICTION,
