@@ -330,7 +330,7 @@ def building_cases():
         ["run", "--scene", "frame:6", "--model", "mass-spring", "--duration", "2", "--json"],
         ["modes", "--scene", "three-storey", "--json"],
         ["modes", "--scene", "frame:6", "--json"],
-        ["modes", "--scene", "frame:30", "--json"],
+        ["modes", "--scene", "frame:20", "--json"],
     ]
     for args in good:
         cases.append(Case("building commands", " ".join(args), args, "ok",

@@ -1294,3 +1294,38 @@ fn a_ground_that_travels_beyond_the_scene_limits_is_refused_by_its_flags() {
     );
     assert!(!err.contains("vertices"), "{err}");
 }
+
+/// The block scene with its block's bottom at height `y` (m).
+fn block_at(y: f64) -> String {
+    let shipped = "vertices = [[-0.5, 0.0], [0.5, 0.0], [0.5, 0.5], [-0.5, 0.5]]";
+    assert!(BLOCK.contains(shipped));
+    BLOCK.replace(
+        shipped,
+        &format!("vertices = [[-0.5, {y}], [0.5, {y}], [0.5, 0.5], [-0.5, 0.5]]"),
+    )
+}
+
+/// A block sunk 10 cm into the ground it has a contact with is refused with the depth at
+/// its file's line (deeper than contact detection reaches, it was reported as an
+/// unsupported block); one floating 30 cm above is told it touches none of its contacts.
+#[test]
+fn a_sunk_or_floating_block_is_told_what_is_wrong() {
+    let err = scene_error(&block_at(-0.1));
+    assert_has(
+        &err,
+        &["s.toml:", "overlaps block 'ground' by 1.0000e-1 m", "only"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("float.toml");
+    std::fs::write(
+        &path,
+        block_at(0.3).replace("0.5, 0.5], [-0.5, 0.5]", "0.5, 0.8], [-0.5, 0.8]"),
+    )
+    .unwrap();
+    let (code, _, err) = cli(&["run", "--scene", path.to_str().unwrap(), "--duration", "1"]);
+    assert_eq!(code, 1, "{err}");
+    assert_has(
+        &err,
+        &["block 'block'", "contacts with 'ground'", "touches none"],
+    );
+}

@@ -93,8 +93,8 @@ impl Dda {
                 time: 0.0,
                 reason:
                     "the initial equilibrium under gravity did not settle (contact states keep \
-                         changing); check that blocks rest on each other, or set \
-                         solver.initial_equilibrium = false"
+                         changing); check that blocks rest on each other (a friction pendulum \
+                         of a few radii below 1.3 m does not settle: see docs/friction-pendulum.md)"
                         .into(),
             });
         };
@@ -106,14 +106,42 @@ impl Dda {
                 time: 0.0,
                 reason: format!(
                     "block '{}' would move {ratio:.3e} structure sizes to reach equilibrium \
-                     under gravity: it is not supported (declare a contact with the block it \
-                     rests on, or a bolt or fixed point that holds it)",
-                    self.blocks[block].name
+                     under gravity: it is not supported ({})",
+                    self.blocks[block].name,
+                    self.support_hint(block)
                 ),
             });
         }
         self.commit_geometry(&increments)?;
         Ok(ratio)
+    }
+
+    /// What to do about an unsupported `block`: declare a contact if it has none; if it
+    /// has some but touches none of those blocks at the start, it floats above them.
+    fn support_hint(&self, block: usize) -> String {
+        let partners: Vec<&str> = (self.pairs.iter())
+            .filter_map(|p| match p.blocks {
+                [a, b] if a == block => Some(b),
+                [a, b] if b == block => Some(a),
+                _ => None,
+            })
+            .map(|other| self.blocks[other].name.as_str())
+            .collect();
+        let touches = (self.contacts.iter())
+            .any(|c| c.key.vertex_block == block || c.key.edge_block == block);
+        match (partners.is_empty(), touches) {
+            (true, _) => "declare a contact with the block it rests on, or a bolt or fixed \
+                          point that holds it"
+                .into(),
+            (false, false) => format!(
+                "it has contacts with '{}' but touches none of them at the start: place it \
+                 on the block it rests on, or hold it with a bolt or fixed point",
+                partners.join("', '")
+            ),
+            (false, true) => "the blocks under it are not held either: declare their \
+                              contacts down to the ground, or bolts or fixed points"
+                .into(),
+        }
     }
 
     /// Natural frequencies and mode shapes of the model about its current state, with every
