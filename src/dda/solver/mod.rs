@@ -256,6 +256,10 @@ pub struct Dda {
     restart: Restart,
     /// When the last step was landed on an event.
     last_landing: f64,
+    /// The largest vertex displacement of the last accepted step over the structure's
+    /// size: below the nominal step, the next one grows no further than the limit allows
+    /// at that motion (see `grown_step`).
+    accepted_displacement_ratio: f64,
     /// How many times the constraint penalties of the step being iterated exceed those
     /// of a nominal step (see `Dda::stiffen_constraints_for`).
     penalty_boost: f64,
@@ -511,6 +515,7 @@ impl Dda {
             last: StepReport::default(),
             restart: Restart::None,
             last_landing: f64::NEG_INFINITY,
+            accepted_displacement_ratio: 0.0,
             penalty_boost: 1.0,
             recent_impacts: Vec::new(),
             pending_events: Vec::new(),

@@ -349,6 +349,7 @@ impl Dda {
                 Ok(passes) => {
                     let ratio = self.max_relative_displacement(&increments, &known);
                     if ratio <= self.params.max_displacement_ratio {
+                        self.accepted_displacement_ratio = ratio;
                         let report = self.commit_step(
                             dt,
                             &increments,
@@ -883,9 +884,19 @@ impl Dda {
         }
     }
 
-    /// The nominal size of the step after an accepted one: back towards Δt after a cut.
+    /// The nominal size of the step after an accepted one: back towards Δt after a cut,
+    /// by at most 1.5× a step, and below Δt no further than to 0.9 of the displacement
+    /// limit at the motion of the step just taken (a vertex's displacement grows with the
+    /// step). Growing blindly, a ground too fast for Δt grew into a cut every third step
+    /// (20 g at Ω/ω = 0.01: 5.6 M cuts in 16.5 M steps).
     fn grown_step(&self) -> f64 {
-        (self.dt_current * 1.5).min(self.params.dt)
+        let grown = (self.dt_current * 1.5).min(self.params.dt);
+        let ratio = self.accepted_displacement_ratio;
+        if self.dt_current >= self.params.dt || ratio <= 0.0 {
+            return grown;
+        }
+        let room = 0.9 * self.params.max_displacement_ratio / ratio;
+        grown.min(self.dt_current * room.max(1.0))
     }
 
     /// Adds the generalised forces the closed contacts exert on the blocks: the normal
