@@ -274,7 +274,7 @@ fn pga_scaling_and_friction_variants_go_through_the_run_setup() {
         .friction_variant_scene(f64::NAN)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("comparison friction"), "{e}");
+    assert!(e.contains("--compare-friction"), "{e}");
 }
 
 /// Issue 12, finding 1 and "Camera": on the default scene at 1600×900, with nothing done
