@@ -7,13 +7,12 @@ use super::friction::Friction;
 use super::scene::{ExcitationDef, Scene};
 use crate::{Error, Result};
 
-/// The built-in scenes: (name, TOML text).
 /// The smallest mass ratio α = m/(M + m) taken: below it the roof's density falls under
 /// the smallest a material may have (a millionth of the mass is already a weightless roof).
 pub const MIN_ALPHA: f64 = 1e-6;
 
-/// Checks a two-block mass ratio α: in [[`MIN_ALPHA`], 1) (the top end is bounded by Δt,
-/// which must resolve the slip phase's period, shorter as α → 1).
+/// Checks a two-block mass ratio α: at least [`MIN_ALPHA`] and below 1 (the top end is
+/// bounded by Δt, which must resolve the slip phase's period, shorter as α → 1).
 pub fn check_alpha(alpha: f64) -> Result<()> {
     if alpha.is_finite() && (MIN_ALPHA..1.0).contains(&alpha) {
         return Ok(());
@@ -28,6 +27,7 @@ pub fn check_alpha(alpha: f64) -> Result<()> {
     ))
 }
 
+/// The built-in scenes: (name, TOML text).
 const BUILTIN: &[(&str, &str)] = &[
     (
         "two-block",
