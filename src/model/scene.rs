@@ -492,6 +492,16 @@ impl Scene {
         Ok(b.material.density * super::geometry::moments(&b.vertices, &b.name)?.area)
     }
 
+    /// The diagonal of the box around every block but the ground's, m: the structure's
+    /// size, of which the solver's tolerances and step limit are fractions.
+    pub fn structure_size(&self) -> f64 {
+        let structure: Vec<Point> = (self.blocks.iter())
+            .filter(|b| b.name != self.ground.block)
+            .flat_map(|b| b.vertices.iter().copied())
+            .collect();
+        super::geometry::bounding_size(&structure)
+    }
+
     /// Index of the block with this name.
     pub fn block_index(&self, name: &str) -> Result<usize> {
         self.blocks

@@ -728,11 +728,7 @@ fn check_span(scene: &Scene, ground: usize) -> Check {
         .filter(|(i, _)| *i != ground)
         .map(|(i, b)| (i, geometry::bounding_size(&b.vertices)))
         .collect();
-    let all: Vec<Point> = structure
-        .iter()
-        .flat_map(|&(i, _)| scene.blocks[i].vertices.iter().copied())
-        .collect();
-    let span = geometry::bounding_size(&all);
+    let span = scene.structure_size();
     let Some(&(smallest, size)) = structure.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
         return Ok(());
     };
@@ -828,11 +824,7 @@ fn check_declared_overlap(scene: &Scene, pair: [usize; 2], depth: Option<f64>) -
     let bonded = scene.contacts.iter().any(|c| {
         c.bonded && (c.blocks == [names[0], names[1]] || c.blocks == [names[1], names[0]])
     });
-    let structure: Vec<Point> = (scene.blocks.iter())
-        .filter(|b| b.name != scene.ground.block)
-        .flat_map(|b| b.vertices.iter().copied())
-        .collect();
-    if bonded || depth <= 1e-6 * geometry::bounding_size(&structure) {
+    if bonded || depth <= 1e-6 * scene.structure_size() {
         return Ok(());
     }
     let second = pair[0].max(pair[1]);

@@ -327,11 +327,7 @@ fn fast_ground(setup: &RunSetup, confirmed: bool) -> Result<Option<String>> {
     if setup.fixed_base || setup.friction.is_infinite() {
         return Ok(None);
     }
-    let structure: Vec<[f64; 2]> = (setup.scene.blocks.iter())
-        .filter(|b| b.name != setup.scene.ground.block)
-        .flat_map(|b| b.vertices.iter().copied())
-        .collect();
-    let size = crate::model::geometry::bounding_size(&structure);
+    let size = setup.scene.structure_size();
     let ratio = setup.solver_params().max_displacement_ratio;
     let speed = setup.motion.peak_velocity(setup.duration);
     let step = ratio * size / speed;
