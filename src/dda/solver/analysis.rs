@@ -20,8 +20,9 @@ impl Dda {
             // shape), and refined on held joints those moves were left to the joints'
             // shear springs — a self-equilibrated shear of ~40 J that a frictionless run
             // let go in its first steps, ringing the frame. Where the refinements free to
-            // slip do not converge (a frame on pendulum bearings drifts down its dishes'
-            // nearly neutral slope), they are undone.
+            // slip do not converge, they are undone. (A frame on pendulum bearings drifted
+            // down its dishes' slope while their contacts had no curvature stiffness:
+            // see `Dda::add_curvature_stiffness`.)
             let settled = self.clone();
             if !self.refines_free_to_slip() {
                 *self = settled;
@@ -89,19 +90,11 @@ impl Dda {
         self.detect_contacts();
         let mut increments = PerBlock::new();
         let Ok(_) = self.iterate(Mode::Static { friction }, &known, &mut increments)? else {
-            // A known failure on curved surfaces is pointed at where it applies.
-            let dish = if self.blocks.iter().any(|b| !b.arcs.is_empty()) {
-                " (a slider on a dish of a few radii below 1.3 m does not settle: see \
-                 docs/friction-pendulum.md)"
-            } else {
-                ""
-            };
             return Err(Error::Solver {
                 time: 0.0,
-                reason: format!(
-                    "the initial equilibrium under gravity did not settle (contact states keep \
-                     changing); check that blocks rest on each other{dish}"
-                ),
+                reason: "the initial equilibrium under gravity did not settle (contact states \
+                         keep changing); check that blocks rest on each other"
+                    .into(),
             });
         };
         let (block, ratio) = self.most_displaced_block(&increments);

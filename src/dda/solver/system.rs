@@ -178,7 +178,41 @@ impl Dda {
                     }
                 }
             }
+            if let (Mode::Static { .. }, true) = (mode, c.state.is_closed()) {
+                self.add_curvature_stiffness(sys, known, c);
+            }
         }
+    }
+
+    /// A static solve's stiffness of a closed contact on a curved surface along its
+    /// slip: the normal force N turns with the vertex as it slides, by κ per metre, and
+    /// pulls it back with N·κ per metre (a dish's pendulum stiffness, W/R for a slider).
+    /// The linear solve has no other stiffness there: two corners of a rigid slider free
+    /// to slip on a dish leave it a mechanism about the dish's centre, held only by the
+    /// settle's 1 mHz mass spring, ~1e-18 of the constraint penalties, and whether the
+    /// factorisation saw it as positive depended on round-off (six radii of 60 between
+    /// 0.5 and 1.3 m did not start). The term acts on the increments only, so the
+    /// refined equilibrium is the same. N is the normal multiplier where the last pass
+    /// found one, else the vertex block's weight (the first pass after closing).
+    fn add_curvature_stiffness(&self, sys: &mut System, known: &[Vec6], c: &Contact) {
+        if c.curvature == 0.0 {
+            return;
+        }
+        let (i, j) = (c.key.vertex_block, c.key.edge_block);
+        let normal = if c.normal_multiplier > 0.0 {
+            c.normal_multiplier
+        } else {
+            self.blocks[i].total_mass() * self.gravity.abs()
+        };
+        let k = normal * c.curvature;
+        sys.add_scalar_spring(
+            &self.dofs,
+            known,
+            k,
+            0.0,
+            (i, &c.slip_i),
+            Some((j, &c.slip_j)),
+        );
     }
 
     /// Dashpot coefficients (normal, shear) of a contact in its trial state.
