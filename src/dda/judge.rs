@@ -58,6 +58,9 @@ pub struct JudgeInput {
     pub open_tolerance: f64,
     /// Slip reversals smaller than this (m) are not reversals: round-off, not physics.
     pub slip_tolerance: f64,
+    /// The surface under the vertex is curved (a dish): a contact closing on it is
+    /// judged by Coulomb's law at once (see [`judge`]).
+    pub curved: bool,
 }
 
 /// Decides the state a contact should have, given a trial solution.
@@ -66,6 +69,14 @@ pub struct JudgeInput {
 ///   the same hysteresis as for opening, so that a vertex grazing at zero force settles
 ///   open instead of flipping between a closed pass in tension and an open one a
 ///   picometre deep — a toppling block's pivot corner did that down to any Δt).
+///   On a curved surface the closing pass's forces (the penetration's and the trial
+///   slip's springs) are weighed first, and a shear beyond ρN closes sliding: a rigid
+///   slider landing on two points of a dish cannot reach the circle at both without
+///   slipping (each corner moves by about the gap times the tangent of its angle), so
+///   both closed stuck ask for a gap and a slip that no rigid motion gives. The
+///   multipliers of such a pair grew without bound, pulled the corners into tension and
+///   open again, and the passes alternated (a slider on a 0.5 m dish under the
+///   trapezoidal rule stopped 24 s into El Centro).
 /// - Closed → Open when the gap opens beyond the tolerance (no tension in contacts).
 /// - Locked → Sliding when the shear spring force exceeds ρN, slipping the way the
 ///   spring was pulled.
@@ -92,21 +103,15 @@ pub fn judge(input: &JudgeInput) -> ContactState {
         return ContactState::Sliding { direction };
     }
     match input.state {
+        // A contact that has just closed on a curved surface: as a locked one whose
+        // spring took the pass's slip (see above).
+        ContactState::Open if input.curved => coulomb(input),
         // A contact that has just closed starts locked: its shear spring takes the
         // tangential motion from this step on.
         ContactState::Open => ContactState::Locked,
         // Infinite friction (a fixed base) holds any force, even with N = 0.
         ContactState::Locked if input.friction.is_infinite() => ContactState::Locked,
-        ContactState::Locked => {
-            let limit = input.friction * input.normal_force;
-            if input.shear_force.abs() > limit * (1.0 + 1e-12) {
-                ContactState::Sliding {
-                    direction: sign_or_plus(input.shear_force),
-                }
-            } else {
-                ContactState::Locked
-            }
-        }
+        ContactState::Locked => coulomb(input),
         ContactState::Sliding { direction } => {
             if input.slip_increment * direction < -input.slip_tolerance {
                 ContactState::Locked
@@ -114,6 +119,19 @@ pub fn judge(input: &JudgeInput) -> ContactState {
                 ContactState::Sliding { direction }
             }
         }
+    }
+}
+
+/// Coulomb's law on a stuck contact's spring: sliding the way it was pulled when its
+/// force exceeds ρN, else stuck.
+fn coulomb(input: &JudgeInput) -> ContactState {
+    let limit = input.friction * input.normal_force;
+    if input.shear_force.abs() > limit * (1.0 + 1e-12) {
+        ContactState::Sliding {
+            direction: sign_or_plus(input.shear_force),
+        }
+    } else {
+        ContactState::Locked
     }
 }
 
@@ -138,6 +156,7 @@ mod tests {
             bonded: false,
             open_tolerance: 1e-9,
             slip_tolerance: 1e-12,
+            curved: false,
         }
     }
 
@@ -161,6 +180,36 @@ mod tests {
                     ..input(Open)
                 },
                 Locked,
+            ),
+            (
+                "open closes sliding on a curve when the closing pass's shear exceeds ρN",
+                JudgeInput {
+                    gap: -2e-9,
+                    shear_force: -51.0,
+                    curved: true,
+                    ..input(Open)
+                },
+                s(-1.0),
+            ),
+            (
+                "open closes stuck on a curve within ρN",
+                JudgeInput {
+                    gap: -2e-9,
+                    shear_force: 49.0,
+                    curved: true,
+                    ..input(Open)
+                },
+                Locked,
+            ),
+            (
+                "open on a curve stays open when apart",
+                JudgeInput {
+                    gap: 1e-3,
+                    shear_force: 1e6,
+                    curved: true,
+                    ..input(Open)
+                },
+                Open,
             ),
             (
                 "open stays open within the tolerance",

@@ -176,6 +176,7 @@ impl Dda {
                     bonded: c.props.bonded,
                     open_tolerance,
                     slip_tolerance,
+                    curved: c.curvature != 0.0,
                 });
                 // Friction acts with the normal force at the step's end, where every force
                 // of the step is balanced (see the integrator).
@@ -210,8 +211,14 @@ impl Dda {
                 // (The secant needs two passes at one coefficient: a velocity law's moves
                 // the found force as well, and a secant across it drifted a box on a
                 // slope 0.2 % off its closed-form speed.)
+                // A contact closing straight into sliding (on a dish) has no normal force
+                // yet: its pass's n_end is the spring of a penetration no contact
+                // resisted (7e10 N for a slider's corner landing 7 µm deep), which as
+                // friction threw the slider 1.9 m within a step. Its first closed pass
+                // slides without friction, and the next uses the force that pass found.
                 let held = sliding && new_state == c.state && !mu_moved;
                 c.friction_normal = match (held, changed_normal) {
+                    _ if sliding && c.state == ContactState::Open => 0.0,
                     (true, true) => next_friction_normal(c.friction_trial, used_normal, n_end),
                     (true, false) => used_normal,
                     (false, _) => n_end,

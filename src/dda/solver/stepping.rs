@@ -182,7 +182,15 @@ impl Dda {
             let result = self.step_with_current_scheme(max_dt, restart, may_restart);
             self.coeffs = scheme;
             match result {
-                Ok(Some(report)) => return Ok(report),
+                Ok(Some(report)) => {
+                    if let Some(reason) = self.rim_passed() {
+                        return Err(Error::Solver {
+                            time: self.time,
+                            reason,
+                        });
+                    }
+                    return Ok(report);
+                }
                 // An event right at the step start: redo the step as a restart.
                 Ok(None) => may_restart = false,
                 Err(e) => return Err(e),
@@ -565,19 +573,37 @@ impl Dda {
     /// Why a step may fail that the solver cannot help: a vertex at the end of a dish's
     /// curved surface (within 1 % of its radius of the rim) is being carried out of it.
     fn rim_reached(&self) -> Option<String> {
+        self.vertex_at_rim(false)
+    }
+
+    /// A vertex carried over a dish's rim (past the end of its arc, within 1 % of the
+    /// radius of it): the run stops there, as a slider that leaves its dish is no longer a
+    /// friction pendulum (a real bearing meets its restrainer ring, which is not
+    /// modelled). Landing on two points of the circle no longer fails the step at the
+    /// rim, and a slider let on over it was thrown at 4e4 g.
+    pub(super) fn rim_passed(&self) -> Option<String> {
+        if self.blocks.iter().all(|b| b.arcs.is_empty()) {
+            return None;
+        }
+        self.vertex_at_rim(true)
+    }
+
+    /// A contact's vertex within 1 % of its radius of an end of a dish's arc (and, with
+    /// `past_only`, outside the arc's span), in words.
+    fn vertex_at_rim(&self, past_only: bool) -> Option<String> {
         self.contacts.iter().find_map(|c| {
             let dish = &self.blocks[c.key.edge_block];
             let p = c.point;
-            // On the arc's last facets or already past its end, on the rim's far side.
             let near = dish.arcs.iter().any(|arc| {
                 let ends = [
                     dish.vertices[arc.edges[0]],
                     dish.vertices[(arc.edges[1] + 1) % dish.vertices.len()],
                 ];
-                ends.iter().any(|e| {
+                let at_an_end = ends.iter().any(|e| {
                     let d = geometry::sub(p, *e);
                     d[0].hypot(d[1]) < 0.01 * arc.radius
-                })
+                });
+                at_an_end && (!past_only || !within_span(arc.center, ends, p))
             });
             near.then(|| {
                 format!(
@@ -1006,6 +1032,15 @@ fn tangential_work(ct: &Contact, end_force: f64, slip: f64, impact: bool) -> (f6
     } else {
         (average, 0.0, 0.0)
     }
+}
+
+/// Whether `p` lies within the angle the radii from `center` to the arc's `ends` span
+/// (an arc of less than half a turn, as a dish's is).
+fn within_span(center: Point, ends: [Point; 2], p: Point) -> bool {
+    let [v0, v1] = ends.map(|e| geometry::sub(e, center));
+    let vp = geometry::sub(p, center);
+    let turn = geometry::cross(v0, v1).signum();
+    geometry::cross(v0, vp) * turn >= 0.0 && geometry::cross(vp, v1) * turn >= 0.0
 }
 
 #[cfg(test)]
