@@ -1119,11 +1119,21 @@ fn cmd_modes(args: ModesArgs) -> Result<()> {
         }
         Err(e) => (None, report, Some(format!("no equivalent MDOF model: {e}"))),
     };
-    // The paper's frequencies are those of its three-storey frame only.
-    let paper = (scene.name == "three-storey").then_some(PAPER_FREQUENCIES_HZ);
+    // The paper's frequencies are those of its three-storey frame only: the built-in
+    // scene, not a file that kept its name (a copy with heavier floors was compared with
+    // them, "paper 0.638 Hz (−24 %)", as if the frame were off).
+    let builtin = slidebase::model::presets::builtin_names().contains(&args.scene.as_str());
+    let paper = (builtin && scene.name == "three-storey").then_some(PAPER_FREQUENCIES_HZ);
+    // A scene file is named by its path beside the name inside it.
+    let title = if args.scene == scene.name {
+        scene.name.clone()
+    } else {
+        format!("{} ({})", scene.name, args.scene)
+    };
     if args.json {
         let mut v = serde_json::json!({
             "scene": report.scene,
+            "scene_source": args.scene,
             "frequencies_hz": report.frequencies_hz,
             "shapes": report.shapes,
             "levels": report.levels,
@@ -1144,8 +1154,7 @@ fn cmd_modes(args: ModesArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     out(&format!(
-        "{}: fixed-base natural frequencies (DDA stiffness and mass)",
-        report.scene
+        "{title}: fixed-base natural frequencies (DDA stiffness and mass)"
     ))?;
     for (k, f) in report.frequencies_hz.iter().enumerate() {
         let paper = paper
