@@ -315,10 +315,10 @@ fn the_pendulum_figure_draws_the_flat_slider_beside_it() {
 }
 
 /// A slider set in its dish comes to rest at the bottom and stays there under gravity
-/// alone, at every radius: its contacts carry its weight (vertical balance to 1e-6,
-/// the open-close iteration's force tolerance is 1e-4 of the largest normal force but
-/// a settled rest has no step-to-step change), and it does not move by a nanometre in
-/// half a second. Six of these radii (0.5 to 1.2 m) did not start before the settle's
+/// alone, at every radius: its contacts carry its weight (to 1e-6 of it: at rest a
+/// step's balance has no inertia left in it, and the multipliers converge far below
+/// that) with no net horizontal force, and it does not move by a nanometre in half a
+/// second. Six of these radii (0.5 to 1.2 m) did not start before the settle's
 /// static solve gave the dish's contacts their curvature stiffness (the two corners free
 /// to slip left the rigid slider a mechanism about the dish's centre).
 #[test]
