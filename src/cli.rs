@@ -1122,8 +1122,7 @@ fn cmd_modes(args: ModesArgs) -> Result<()> {
     // The paper's frequencies are those of its three-storey frame only: the built-in
     // scene, not a file that kept its name (a copy with heavier floors was compared with
     // them, "paper 0.638 Hz (−24 %)", as if the frame were off).
-    let builtin = slidebase::model::presets::builtin_names().contains(&args.scene.as_str());
-    let paper = (builtin && scene.name == "three-storey").then_some(PAPER_FREQUENCIES_HZ);
+    let paper = (args.scene == "three-storey").then_some(PAPER_FREQUENCIES_HZ);
     // A scene file is named by its path beside the name inside it.
     let title = if args.scene == scene.name {
         scene.name.clone()
