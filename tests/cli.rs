@@ -237,6 +237,38 @@ fn modes_compares_with_the_paper_only_for_the_built_in_frame() {
     );
 }
 
+/// `report`'s paper column holds the paper's own case only: beside `frame:5` it showed
+/// the three-storey frame's 0.638 Hz, and beside a 1 s run the paper's ≈ 0.3 m slip.
+#[test]
+fn the_report_compares_with_the_paper_only_for_its_case() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = slidebase(&[
+        "report",
+        "--scene",
+        "frame:5",
+        "--duration",
+        "1",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    for paper_value in ["0.638", "≈ 0.3", "≈ 1.5"] {
+        assert!(
+            !summary.contains(paper_value),
+            "{paper_value} in\n{summary}"
+        );
+    }
+    assert!(
+        summary.contains("filled only for its own case"),
+        "{summary}"
+    );
+}
+
 #[test]
 fn modes_json_and_a_short_report() {
     let out = slidebase(&["modes", "--scene", "three-storey", "--json"]);
