@@ -5,6 +5,7 @@ mod cli;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    quiet_mesa_device_select_without_a_session();
     match cli::main() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -22,6 +23,26 @@ fn main() -> ExitCode {
             eprintln!("error: {}", shorten_long_words(&message));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Mesa's Vulkan device-select layer (an implicit layer of every Vulkan instance where
+/// Mesa's drivers are installed) asks Wayland for the session's default GPU, and
+/// libwayland prints "error: XDG_RUNTIME_DIR is invalid or not set in the environment."
+/// when there is no session: twice for each `render`, four times as the window opens, on
+/// every headless machine (containers, CI) although nothing failed. Without
+/// `XDG_RUNTIME_DIR` there is no Wayland session to ask, so the layer is switched off by
+/// Mesa's own switch, `NODEVICE_SELECT` (it only orders the GPUs; wgpu chooses the adapter
+/// itself). A user's own `NODEVICE_SELECT` is left as it is.
+#[allow(unsafe_code)]
+fn quiet_mesa_device_select_without_a_session() {
+    if cfg!(target_os = "linux")
+        && std::env::var_os("XDG_RUNTIME_DIR").is_none()
+        && std::env::var_os("NODEVICE_SELECT").is_none()
+    {
+        // SAFETY: called first in `main`, before any thread exists that could read or
+        // write the environment at the same time.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
 }
 

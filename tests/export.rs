@@ -103,6 +103,30 @@ fn a_picture_with_its_plot_data() {
     assert!(names.iter().any(|n| n == "base, fixed base"), "{names:?}");
 }
 
+/// On a headless machine (no `XDG_RUNTIME_DIR`, as in containers and CI) a picture is
+/// made without a word on stderr: Mesa's device-select layer used to have libwayland print
+/// "error: XDG_RUNTIME_DIR is invalid or not set in the environment." twice although
+/// nothing failed.
+#[test]
+fn a_headless_picture_prints_no_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("quiet.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_slidebase"))
+        .args(["render", "--scene", "two-block", "--time", "0.5"])
+        .args(["--width", "240", "--height", "136", "--out"])
+        .arg(&png)
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    if !had_adapter(&out, "a_headless_picture_prints_no_errors") {
+        return;
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("error"), "stderr: {stderr}");
+}
+
 #[test]
 fn a_replay_without_ffmpeg_is_an_animated_gif() {
     let dir = tempfile::tempdir().unwrap();
