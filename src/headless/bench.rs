@@ -15,6 +15,7 @@ use serde::Serialize;
 use super::frame::run_frame;
 use super::run::run;
 use super::sweep::{SweepRequest, paper_ratios, parse_ratios, run_sweep};
+use super::targets::{self, Bound, TargetCheck};
 use crate::dda::{Dda, SolverParams};
 use crate::ground_motion::{GroundMotion, Record, resolve_record};
 use crate::model::Scene;
@@ -54,6 +55,9 @@ impl Default for BenchOptions {
 /// One timed workload.
 #[derive(Debug, Clone, Serialize)]
 pub struct Measurement {
+    /// Which workload, for the targets (`two-block`, `exact`, `three-storey-sliding`,
+    /// `three-storey-fixed`).
+    pub key: &'static str,
     /// What was run.
     pub name: String,
     /// How many times.
@@ -148,6 +152,8 @@ pub struct BenchReport {
     pub scaling: Vec<ScalingPoint>,
     /// Exponents of time per step against unknowns.
     pub exponents: Vec<ExponentFit>,
+    /// Issue 16's speed targets against this run's measurements.
+    pub targets: Vec<TargetCheck>,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -161,6 +167,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Runs `f` `repeats` times; `f` returns (wall time, steps, simulated time).
 fn measure(
+    key: &'static str,
     name: &str,
     repeats: usize,
     mut f: impl FnMut() -> Result<(f64, u64, f64)>,
@@ -175,6 +182,7 @@ fn measure(
     let min_s = times.iter().copied().fold(f64::INFINITY, f64::min);
     let median_s = median(times.clone());
     Ok(Measurement {
+        key,
         name: name.into(),
         runs: times.len(),
         median_s,
@@ -318,24 +326,28 @@ pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Benc
     let mut workloads = Vec::new();
     progress("two-block DDA, 100 s");
     workloads.push(measure(
+        "two-block",
         "two-block DDA (α = 0.5, ρ = 0.1, Ω = ω, 0.3 g), 100 s, Δt = 1 ms",
         repeats,
         || two_block(ModelKind::Dda),
     )?);
     progress("two-block exact model, 100 s");
     workloads.push(measure(
+        "exact",
         "two-block exact mass-spring model, 100 s",
         repeats,
         || two_block(ModelKind::MassSpring),
     )?);
     progress("three-storey El Centro, sliding base");
     workloads.push(measure(
+        "three-storey-sliding",
         "three-storey El Centro, sliding base (ρ = 0.01), Δt = 1 ms",
         repeats,
         || three_storey(false),
     )?);
     progress("three-storey El Centro, fixed base");
     workloads.push(measure(
+        "three-storey-fixed",
         "three-storey El Centro, fixed base, Δt = 1 ms",
         repeats,
         || three_storey(true),
@@ -389,12 +401,20 @@ pub fn run_bench(options: &BenchOptions, progress: &dyn Fn(&str)) -> Result<Benc
             });
         }
     }
+    let targets = targets::check(&targets::Measured {
+        workloads: &workloads,
+        sweep: sweep.as_ref(),
+        scaling: &scaling,
+        exponents: &exponents,
+        quick: options.quick,
+    });
     Ok(BenchReport {
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
         workloads,
         sweep,
         scaling,
         exponents,
+        targets,
     })
 }
 
@@ -516,7 +536,43 @@ pub fn report_text(r: &BenchReport) -> String {
             );
         }
     }
+    write_targets(&mut s, &r.targets);
     s
+}
+
+/// The targets as a table: goal, this run's measurement, how far off, met or not (or the
+/// command that measures it).
+fn write_targets(s: &mut String, checks: &[TargetCheck]) {
+    let _ = writeln!(
+        s,
+        "\nIssue 16's targets on this machine:\n{:<48} {:>18} {:>12} {:>8}  met",
+        "target", "goal", "measured", "off by"
+    );
+    for t in checks {
+        let sign = match t.bound {
+            Bound::AtMost => "≤",
+            Bound::AtLeast => "≥",
+        };
+        let goal = format!("{sign} {} {}", t.goal, t.unit);
+        let _ = match (t.measured, t.off_by, t.met) {
+            (Some(v), Some(off), Some(met)) => writeln!(
+                s,
+                "{:<48} {:>18} {:>12} {:>7.1}×  {}",
+                t.target,
+                goal.trim_end(),
+                format!("{v:.4} {}", t.unit).trim_end(),
+                off,
+                if met { "yes" } else { "no" }
+            ),
+            _ => writeln!(
+                s,
+                "{:<48} {:>18}  not measured here: {}",
+                t.target,
+                goal.trim_end(),
+                t.how.unwrap_or("-")
+            ),
+        };
+    }
 }
 
 /// Writes `bench.json`, `scaling.csv` and `scaling.png` into `out`.

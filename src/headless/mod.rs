@@ -13,3 +13,4 @@ pub mod run;
 pub mod simulate;
 pub mod stability;
 pub mod sweep;
+pub mod targets;

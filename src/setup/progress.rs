@@ -364,8 +364,8 @@ mod tests {
 
     /// A cost that saturates in the strong motion (as a wall's does once it factorises at
     /// every step): before it, the fit learns a large cost per unit of shaking from the
-    /// shaking's rise and would promise ~5 times the truth; the time left is the pace
-    /// instead, a lower bound of the truth.
+    /// shaking's rise and would promise more than three times the truth; the time left is
+    /// the pace instead, a lower bound of the truth.
     #[test]
     fn before_the_strong_motion_the_time_left_is_a_lower_bound() {
         let accel = (0..=300)
