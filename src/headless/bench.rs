@@ -152,7 +152,7 @@ pub struct BenchReport {
     pub scaling: Vec<ScalingPoint>,
     /// Exponents of time per step against unknowns.
     pub exponents: Vec<ExponentFit>,
-    /// Issue 16's speed targets against this run's measurements.
+    /// The speed targets (issue 16, docs/performance.md) against this run's measurements.
     pub targets: Vec<TargetCheck>,
 }
 
@@ -545,7 +545,8 @@ pub fn report_text(r: &BenchReport) -> String {
 fn write_targets(s: &mut String, checks: &[TargetCheck]) {
     let _ = writeln!(
         s,
-        "\nIssue 16's targets on this machine:\n{:<48} {:>18} {:>12} {:>8}  met",
+        "\nSpeed targets (docs/performance.md) on this machine:\n\
+         {:<48} {:>18} {:>12} {:>8}  met",
         "target", "goal", "measured", "off by"
     );
     for t in checks {

@@ -1,7 +1,7 @@
-//! Issue 16's speed targets set beside what `slidebase bench` measured, so that a run of
-//! the bench says by itself which goals this machine meets (and a pipeline can read it from
-//! the JSON). Two targets take longer than a bench or need a display; they are listed with
-//! the command that measures them.
+//! The speed targets (issue 16; docs/performance.md) set beside what `slidebase bench`
+//! measured, so that a run of the bench says by itself which goals this machine meets (and
+//! a pipeline can read it from the JSON). Two targets take longer than a bench or need a
+//! display; they are listed with the command that measures them.
 
 use serde::Serialize;
 
