@@ -1104,7 +1104,7 @@ fn cmd_report(args: ReportArgs) -> Result<()> {
 
 fn cmd_modes(args: ModesArgs) -> Result<()> {
     use slidebase::headless::frame::{
-        MDOF_FIT_TOLERANCE, PAPER_FREQUENCIES_HZ, equivalent_mdof_with, mdof_fit_warning, modes,
+        MDOF_FIT_TOLERANCE, equivalent_mdof_with, mdof_fit_warning, modes, paper_frequencies_for,
     };
     let scene = slidebase::model::presets::resolve_scene(&args.scene)?;
     let report = modes(&scene)?;
@@ -1119,10 +1119,7 @@ fn cmd_modes(args: ModesArgs) -> Result<()> {
         }
         Err(e) => (None, report, Some(format!("no equivalent MDOF model: {e}"))),
     };
-    // The paper's frequencies are those of its three-storey frame only: the built-in
-    // scene, not a file that kept its name (a copy with heavier floors was compared with
-    // them, "paper 0.638 Hz (−24 %)", as if the frame were off).
-    let paper = (args.scene == "three-storey").then_some(PAPER_FREQUENCIES_HZ);
+    let paper = paper_frequencies_for(&args.scene);
     // A scene file is named by its path beside the name inside it.
     let title = if args.scene == scene.name {
         scene.name.clone()

@@ -19,6 +19,14 @@ use crate::{Error, Result};
 /// The paper's natural frequencies of its three-storey frame, Hz.
 pub const PAPER_FREQUENCIES_HZ: [f64; 3] = [0.638, 1.788, 2.583];
 
+/// The paper's frequencies to set beside the scene asked for as `scene` (a name or a
+/// file): only its own frame, the built-in `three-storey`. A file that kept the name, or
+/// another frame, is not the paper's (a copy with heavier floors was shown "paper 0.638 Hz
+/// (−24 %)" as if the frame were off; `frame:5` beside 0.638 Hz).
+pub fn paper_frequencies_for(scene: &str) -> Option<[f64; 3]> {
+    (scene == "three-storey").then_some(PAPER_FREQUENCIES_HZ)
+}
+
 pub use crate::setup::modes::{ModesReport, frame_roles, modes, roles};
 
 /// Summary of a building run (the JSON object of `run --json`). A quantity that is

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::frame::{FrameOutcome, PAPER_FREQUENCIES_HZ, equivalent_mdof, run_frame, run_mdof};
+use super::frame::{FrameOutcome, equivalent_mdof, paper_frequencies_for, run_frame, run_mdof};
 use crate::Result;
 use crate::dda::Integrator;
 use crate::ground_motion::STANDARD_GRAVITY;
@@ -400,8 +400,8 @@ pub fn summary_markdown(
     // Centro at ρ = 0.01 (the responses). Beside another frame, record, friction or
     // duration it compared unlike things: frame:5's first frequency beside the paper's
     // 0.638 Hz, a 1 s run's slip beside its ≈ 0.3 m.
-    let paper_frame = req.scene == "three-storey";
-    let paper_run = paper_frame
+    let paper_frequencies = paper_frequencies_for(&req.scene);
+    let paper_run = paper_frequencies.is_some()
         && req.record.as_deref().is_none_or(|r| r == "el-centro")
         && req.friction.is_none_or(|f| f == 0.01)
         && req.duration.is_none();
@@ -428,8 +428,7 @@ pub fn summary_markdown(
         &r.mdof_fixed.summary,
     );
     for (k, f) in modes.frequencies_hz.iter().enumerate() {
-        let paper = (PAPER_FREQUENCIES_HZ.get(k))
-            .filter(|_| paper_frame)
+        let paper = (paper_frequencies.and_then(|p| p.get(k).copied()))
             .map_or("–".into(), |p| format!("{p}"));
         row(
             &mut s,
