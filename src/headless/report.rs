@@ -428,7 +428,8 @@ pub fn summary_markdown(
         &r.mdof_fixed.summary,
     );
     for (k, f) in modes.frequencies_hz.iter().enumerate() {
-        let paper = (paper_frequencies.and_then(|p| p.get(k).copied()))
+        let paper = paper_frequencies
+            .and_then(|p| p.get(k).copied())
             .map_or("–".into(), |p| format!("{p}"));
         row(
             &mut s,
