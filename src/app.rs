@@ -241,6 +241,9 @@ struct SmokeTest {
     /// friction (a slider drag: the fixed base is played back); the third changes the
     /// record's scale, so both models are computed again.
     runs: Vec<(u64, f64)>,
+    /// The speeds were printed and the window asked to close: the frames drawn before
+    /// it closes must not print them again (one line per check, for scripts to parse).
+    reported: bool,
 }
 
 impl SmokeTest {
@@ -248,6 +251,7 @@ impl SmokeTest {
         Self {
             exit_after,
             runs: Vec::new(),
+            reported: false,
         }
     }
 
@@ -290,7 +294,11 @@ impl App {
             }
         }
         let elapsed = self.started.elapsed().as_secs_f64();
+        if smoke.reported {
+            return;
+        }
         if elapsed >= smoke.exit_after {
+            smoke.reported = true;
             println!(
                 "frame time {:.1} ms, simulation {}, frames drawn {}, frame copy-out {:.0} µs, batch take-in {:.1} µs",
                 self.state.frame_ms,
