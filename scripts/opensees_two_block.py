@@ -83,13 +83,15 @@ def run(args):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--alpha", type=float, default=0.5)
-    ap.add_argument("--rho", type=float, default=0.1)
-    ap.add_argument("--ratio", type=float, default=1.0)
-    ap.add_argument("--duration", type=float, default=100.0)
-    ap.add_argument("--dt", type=float, default=0.001)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--alpha", type=float, default=0.5, help="mass ratio m/(M + m) (0.5)")
+    ap.add_argument("--rho", type=float, default=0.1, help="friction coefficient (0.1)")
+    ap.add_argument("--ratio", type=float, default=1.0,
+                    help="excitation over structure frequency, Omega/omega (1)")
+    ap.add_argument("--duration", type=float, default=100.0, help="seconds of motion (100)")
+    ap.add_argument("--dt", type=float, default=0.001, help="time step, s (0.001)")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="timed runs; the median is printed (3)")
     args = ap.parse_args()
     runs = [run(args) for _ in range(args.repeat)]
     us, ab, _, retries = runs[-1]

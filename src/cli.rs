@@ -159,8 +159,8 @@ struct RunArgs {
 /// The time stepping of runs (`run` and `sweep`).
 #[derive(Debug, clap::Args)]
 struct Stepping {
-    /// Duration of a run, s (default: 100 s for harmonic input, the record's length for a
-    /// record).
+    /// Duration of a run, s (default: 100 s for harmonic input, as every sweep's; for a
+    /// `run` on a record, the record's length).
     #[arg(long, allow_hyphen_values = true)]
     duration: Option<f64>,
     /// Time step of the DDA model, s (default 1e-3).
@@ -535,10 +535,13 @@ fn cmd_run(args: RunArgs) -> Result<()> {
         opt(s.aroof_over_aground)
     ))?;
     out(&format!("  residual slip     {:.4e} m", s.residual_slip_m))?;
-    out(&format!(
-        "  {} steps, {} open-close passes, {} Δt cuts, max penetration {:.2e} of size",
-        s.steps, s.open_close_passes, s.dt_cuts, s.max_penetration_ratio
-    ))?;
+    out(&match &s.solver {
+        Some(c) => format!(
+            "  {} steps, {} open-close passes, {} Δt cuts, max penetration {:.2e} of size",
+            s.steps, c.open_close_passes, c.dt_cuts, c.max_penetration_ratio
+        ),
+        None => format!("  {} propagation steps", s.steps),
+    })?;
     out(&format!(
         "  energy: input {:.4e} J/m, friction {:.4e} J/m, residual {:.2e} (relative)",
         s.input_work_j, s.friction_dissipated_j, s.energy_residual_rel
@@ -598,19 +601,19 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
             staged.commit()?;
             let csv = args.out.join("sweep.csv");
             out(&format!(
-                "wrote {} (shard {i}/{n}: {} runs in {:.1} s); join the shards with \
+                "wrote {} (shard {i}/{n}: {} in {}); join the shards with \
                  `slidebase merge --out DIR SHARD/sweep.csv…`",
                 csv.display(),
-                rows.len(),
-                start.elapsed().as_secs_f64()
+                count(rows.len(), "run"),
+                elapsed(start)
             ))?;
         }
         None => {
             write_sweep_outputs(&rows, &args.out)?;
             out(&format!(
-                "{} runs in {:.1} s",
-                rows.len(),
-                start.elapsed().as_secs_f64()
+                "{} in {}",
+                count(rows.len(), "run"),
+                elapsed(start)
             ))?;
         }
     }
@@ -628,6 +631,26 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
         bail!("{} of {} runs failed", failures.len(), total);
     }
     Ok(())
+}
+
+/// "1 run", "4 runs".
+fn count(n: usize, what: &str) -> String {
+    if n == 1 {
+        format!("1 {what}")
+    } else {
+        format!("{n} {what}s")
+    }
+}
+
+/// The time since `start` as a reader wants it: "0.024 s", "3.41 s", "75.2 s" (a quick
+/// sweep is not "0.0 s").
+fn elapsed(start: std::time::Instant) -> String {
+    let t = start.elapsed().as_secs_f64();
+    match t {
+        t if t < 1.0 => format!("{t:.3} s"),
+        t if t < 10.0 => format!("{t:.2} s"),
+        t => format!("{t:.1} s"),
+    }
 }
 
 /// Writes sweep.csv, the paper's figures and errors.md for a finished sweep (all or
@@ -689,6 +712,7 @@ fn cmd_merge(args: MergeArgs) -> Result<()> {
             );
         }
     }
+    slidebase::post::sweep::whole_grid(&rows).map_err(|e| anyhow!("invalid merge: {e}"))?;
     write_sweep_outputs(&rows, &args.out)
 }
 
@@ -730,6 +754,25 @@ fn cmd_bench(args: BenchArgs) -> Result<()> {
     if let Some(dir) = &args.out {
         for f in write_bench(&report, dir)? {
             eprintln!("wrote {}", f.display());
+        }
+        // Without the series the old plot stays beside a bench.json that has none: say
+        // so rather than delete files a user may have kept on purpose.
+        let stale: Vec<_> = ["scaling.csv", "scaling.png"]
+            .iter()
+            .map(|f| dir.join(f))
+            .filter(|f| report.scaling.is_empty() && f.exists())
+            .collect();
+        if !stale.is_empty() {
+            eprintln!(
+                "note: {} {} from an earlier bench: this one ran without the scaling \
+                 series (--no-scaling), and its bench.json has none",
+                stale
+                    .iter()
+                    .map(|f| f.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(" and "),
+                if stale.len() == 1 { "is" } else { "are" }
+            );
         }
     }
     Ok(())
@@ -848,11 +891,13 @@ fn cmd_run_frame(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         out(&format!("  base accel spectrum   peak at {f:.3} Hz"))?;
     }
     out(&format!(
-        "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
-        s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
+        "  {}, energy residual {:.2e}, wall {:.2} s",
+        steps_and_counts(s.steps, s.solver.as_ref()),
+        s.energy_residual_rel,
+        s.wall_time_s
     ))?;
-    if s.dt_cuts > 0 {
-        let why = s.dt_cut_reasons;
+    if let Some(c) = s.solver.filter(|c| c.dt_cuts > 0) {
+        let why = c.dt_cut_reasons;
         out(&format!(
             "  Δt cuts: {} because a held contact contradicted its gap, {} because contacts \
              still changed state, {} because friction forces still moved (at the last open-close \
@@ -896,9 +941,26 @@ fn cmd_run_block(args: &RunArgs, setup: &slidebase::setup::RunSetup) -> Result<(
         s.peak_base_accel_g, s.peak_ground_accel_g
     ))?;
     out(&format!(
-        "  {} steps, {} passes, {} Δt cuts, energy residual {:.2e}, wall {:.2} s",
-        s.steps, s.open_close_passes, s.dt_cuts, s.energy_residual_rel, s.wall_time_s
+        "  {}, energy residual {:.2e}, wall {:.2} s",
+        steps_and_counts(s.steps, s.solver.as_ref()),
+        s.energy_residual_rel,
+        s.wall_time_s
     ))
+}
+
+/// "N steps, P passes, C Δt cuts" of a DDA run; an exact model's steps alone (it has no
+/// passes or cuts to report).
+fn steps_and_counts(
+    steps: u64,
+    solver: Option<&slidebase::headless::simulate::SolverCounts>,
+) -> String {
+    match solver {
+        Some(c) => format!(
+            "{steps} steps, {} passes, {} Δt cuts",
+            c.open_close_passes, c.dt_cuts
+        ),
+        None => format!("{steps} steps"),
+    }
 }
 
 /// The picture flags of `render` in their ranges (a 10⁵ × 10⁵ picture is 40 GB) and what

@@ -362,12 +362,24 @@ fn a_ground_too_fast_for_the_step_is_followed_without_repeated_cuts() {
         "steps were not shortened: {}",
         dda.steps
     );
-    assert!(
-        dda.dt_cuts * 100 < dda.steps,
-        "{} cuts in {} steps",
-        dda.dt_cuts,
-        dda.steps
-    );
+    let cuts = dda.solver.expect("a DDA run has solver counters").dt_cuts;
+    assert!(cuts * 100 < dda.steps, "{cuts} cuts in {} steps", dda.steps);
+    // The exact model has no passes, cuts or factorisations: its JSON leaves them out
+    // rather than report zeros.
+    assert!(exact.solver.is_none());
+    let json = serde_json::to_value(&exact).unwrap();
+    for key in [
+        "open_close_passes",
+        "dt_cuts",
+        "dt_cut_reasons",
+        "factorizations",
+    ] {
+        assert!(json.get(key).is_none(), "exact model's JSON has {key}");
+        assert!(
+            serde_json::to_value(&dda).unwrap().get(key).is_some(),
+            "{key}"
+        );
+    }
     let (d, e) = (dda.us_max_over_d.unwrap(), exact.us_max_over_d.unwrap());
     assert!((d - e).abs() < 1e-5 * e, "slip {d} against the exact {e}");
 }

@@ -523,28 +523,28 @@ fn merge_refuses_unusable_tables() {
     );
     for (row, what) in [
         (
-            "dda,0.5,0.1,1,0,NaN,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "dda,0.5,0.1,1,0,NaN,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5,4",
             "us_max_over_d NaN",
         ),
         (
-            "dda,-5,0.1,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "dda,-5,0.1,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5,4",
             "alpha -5",
         ),
         (
-            "foo,0.5,0.1,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "foo,0.5,0.1,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5,4",
             "unknown model 'foo'",
         ),
         (
-            "dda,0.5,inf,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "dda,0.5,inf,1,0,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5,4",
             "friction inf",
         ),
         (
-            "dda,0.5,0.1,1,1.5,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
+            "dda,0.5,0.1,1,1.5,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5,4",
             "damping 1.5",
         ),
         (
-            "dda,0.5,0.1,1,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5",
-            "15 fields",
+            "dda,0.5,0.1,1,1,1,1,1,5,0.1,0,0.3,100,0.001,generalized-alpha:0.5,4",
+            "16 fields",
         ),
     ] {
         let e = read_table(&format!("{header}\n{row}\n")).unwrap_err();
@@ -1166,6 +1166,7 @@ fn merge_refuses_shards_of_other_run_set_ups() {
         duration_s: Some(duration),
         dt_s: Some(1e-3),
         integrator: Some("generalized-alpha:0.5".into()),
+        grid_runs: Some(2),
     };
     let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
     write_sweep_csv(&a, &[row(1.0, 2.0)]).unwrap();
@@ -1264,7 +1265,7 @@ fn a_bad_sweep_cell_is_named_by_column_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("s.csv");
     let header = SweepRow::COLUMNS.join(",");
-    let row = "mass-spring,0.5,0.1,x,0.0,3.4,1.1,0.96,1.13,93,0.0002,0.0,0.3,2.0,,";
+    let row = "mass-spring,0.5,0.1,x,0.0,3.4,1.1,0.96,1.13,93,0.0002,0.0,0.3,2.0,,,4";
     std::fs::write(&path, format!("{header}\r\n{row}\r\n")).unwrap();
     let err = read_sweep_csv(&path).unwrap_err().to_string();
     assert_has(&err, &["s.csv:2", "column 'freq_ratio'", "got 'x'"]);

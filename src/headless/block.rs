@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::simulate::{self, ModelRun};
+use super::simulate::{self, ModelRun, SolverCounts};
 use crate::analytic::{SlidingBlock, SteppedOptions, Surface, simulate_block};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::history::History;
@@ -53,14 +53,9 @@ pub struct BlockSummary {
     pub peak_ground_accel_g: f64,
     /// Time steps (DDA) or integration steps (exact model).
     pub steps: u64,
-    /// Open-close passes (DDA).
-    pub open_close_passes: u64,
-    /// Δt cuts (DDA).
-    pub dt_cuts: u64,
-    /// Numeric factorisations of the system matrix (DDA).
-    pub factorizations: u64,
-    /// Largest penetration / block size (DDA).
-    pub max_penetration_ratio: f64,
+    /// What the DDA solver did (left out for the exact model).
+    #[serde(flatten)]
+    pub solver: Option<SolverCounts>,
     /// Energy residual relative to the energy through the block.
     pub energy_residual_rel: f64,
     /// Work done by the ground on the block, J per m of thickness.
@@ -312,10 +307,7 @@ fn summarise(setup: &RunSetup, run: &ModelRun) -> BlockSummary {
         peak_base_accel_g: run.peaks.base_accel / STANDARD_GRAVITY,
         peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
         steps: run.steps,
-        open_close_passes: run.passes,
-        dt_cuts: run.cuts,
-        factorizations: run.factorizations,
-        max_penetration_ratio: run.max_penetration_ratio,
+        solver: run.solver_counts(),
         energy_residual_rel: run.energy_residual_rel,
         input_work_j: run.input_work,
         friction_dissipated_j: run.friction_dissipated,

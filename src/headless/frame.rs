@@ -5,9 +5,9 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::simulate::{self, ModelRun, SPECTRUM_DT, SPECTRUM_MAX_SAMPLES};
+use super::simulate::{self, ModelRun, SPECTRUM_DT, SPECTRUM_MAX_SAMPLES, SolverCounts};
 use crate::analytic::{ExactOptions, ShearBuilding, simulate};
-use crate::dda::{CutReasons, Dda, FrictionLaw, Integrator, SolverParams};
+use crate::dda::{Dda, FrictionLaw, Integrator, SolverParams};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::model::Scene;
 use crate::model::scene::ExcitationDef;
@@ -89,17 +89,9 @@ pub struct FrameSummary {
     pub base_accel_peak_freq_hz: Option<f64>,
     /// Time steps.
     pub steps: u64,
-    /// Open-close passes (DDA).
-    pub open_close_passes: u64,
-    /// Δt cuts (DDA).
-    pub dt_cuts: u64,
-    /// What forced the Δt cuts.
-    pub dt_cut_reasons: CutReasons,
-    /// Numeric factorisations of the system matrix (DDA; the other passes were solved
-    /// with a kept factor).
-    pub factorizations: u64,
-    /// Largest penetration / structure size (DDA).
-    pub max_penetration_ratio: f64,
+    /// What the DDA solver did (left out for the exact model).
+    #[serde(flatten)]
+    pub solver: Option<SolverCounts>,
     /// Energy residual relative to the energy through the structure.
     pub energy_residual_rel: f64,
     /// Wall-clock time, s.
@@ -225,11 +217,7 @@ fn summarise(
         peak_roof_drift_m: p.drift_m,
         base_accel_peak_freq_hz: peak_freq,
         steps: run.steps,
-        open_close_passes: run.passes,
-        dt_cuts: run.cuts,
-        dt_cut_reasons: run.cut_reasons,
-        factorizations: run.factorizations,
-        max_penetration_ratio: run.max_penetration_ratio,
+        solver: run.solver_counts(),
         energy_residual_rel: run.energy_residual_rel,
         wall_time_s: run.wall_time_s,
         warnings,

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::block::{SlipOverlay, draw_overlays};
-use super::simulate::{self, ModelRun};
+use super::simulate::{self, ModelRun, SolverCounts};
 use crate::ground_motion::STANDARD_GRAVITY;
 use crate::post::output::Staged;
 use crate::setup::{ModelKind, RunSetup, RunSpec, defaults};
@@ -73,12 +73,9 @@ pub struct RunSummary {
     pub residual_slip_m: f64,
     /// Time steps.
     pub steps: u64,
-    /// Open-close passes (DDA).
-    pub open_close_passes: u64,
-    /// Δt cuts (DDA).
-    pub dt_cuts: u64,
-    /// Largest penetration / structure size (DDA).
-    pub max_penetration_ratio: f64,
+    /// What the DDA solver did (left out for the exact model).
+    #[serde(flatten)]
+    pub solver: Option<SolverCounts>,
     /// Energy residual (numerical dissipation) relative to the energy through the system.
     pub energy_residual_rel: f64,
     /// Work done by the ground on the structure, J/m.
@@ -163,9 +160,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         ur_max_m: run.peaks.drift_m,
         residual_slip_m: run.residual_slip_m,
         steps: run.steps,
-        open_close_passes: run.passes,
-        dt_cuts: run.cuts,
-        max_penetration_ratio: run.max_penetration_ratio,
+        solver: run.solver_counts(),
         energy_residual_rel: run.energy_residual_rel,
         input_work_j: run.input_work,
         friction_dissipated_j: run.friction_dissipated,

@@ -75,7 +75,37 @@ pub struct ModelRun {
     pub lift_off_time_s: Option<f64>,
 }
 
+/// What a DDA run's solver did, as a run's summary reports it (flattened into its JSON
+/// object). An exact model has none of it, and its summary leaves these keys out rather
+/// than report zeros.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SolverCounts {
+    /// Open-close passes.
+    pub open_close_passes: u64,
+    /// Δt cuts.
+    pub dt_cuts: u64,
+    /// What forced the Δt cuts.
+    pub dt_cut_reasons: CutReasons,
+    /// Numeric factorisations of the system matrix: the passes' solves that did not
+    /// reuse a kept factor, and those of the event projections (so they can exceed the
+    /// passes when every solve factorises, as a frame's does).
+    pub factorizations: u64,
+    /// Largest penetration / structure size.
+    pub max_penetration_ratio: f64,
+}
+
 impl ModelRun {
+    /// The solver's counters of a DDA run; `None` for an exact model, which has none.
+    pub fn solver_counts(&self) -> Option<SolverCounts> {
+        (self.model == ModelKind::Dda).then_some(SolverCounts {
+            open_close_passes: self.passes,
+            dt_cuts: self.cuts,
+            dt_cut_reasons: self.cut_reasons,
+            factorizations: self.factorizations,
+            max_penetration_ratio: self.max_penetration_ratio,
+        })
+    }
+
     /// The warning a run's summary carries when its base lifted off at a corner (not for
     /// vertical shaking, whose lift-off is warned of before the run).
     pub fn lift_off_warning(&self, vertical: bool) -> Option<String> {

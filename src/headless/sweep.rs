@@ -175,7 +175,7 @@ pub fn parse_ratios(flag: &str, text: &str) -> Result<Vec<f64>> {
     if !(lo > 0.0 && hi >= lo && lo.is_finite() && hi.is_finite()) || n == 0 {
         return Err(Error::invalid(
             flag,
-            "expected lo:hi:n with 0 < lo <= hi and n >= 1",
+            format!("expected lo:hi:n with 0 < lo <= hi and n >= 1, got '{text}'"),
         ));
     }
     if n > MAX_LIST_VALUES {
@@ -205,7 +205,7 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
     let bad = || {
         Error::invalid(
             "--shard",
-            format!("expected I/N with 1 <= I <= N (e.g. 3/8), got '{text}'"),
+            format!("expected I/N with 1 <= I <= N <= {MAX_SWEEP_RUNS} (e.g. 3/8), got '{text}'"),
         )
     };
     let (i, n) = text.split_once('/').ok_or_else(bad)?;
@@ -266,6 +266,18 @@ impl SweepRequest {
                 "a list is empty",
             ));
         };
+        let runs = self.grid_runs();
+        if let Some((i, n)) = self.shard
+            && n > runs
+        {
+            return Err(Error::invalid(
+                "--shard",
+                format!(
+                    "{i}/{n}: the grid has {runs} runs (both models), fewer than the {n} \
+                     shards, so some would be empty; give N <= {runs}"
+                ),
+            ));
+        }
         for &model in &self.models {
             let points = self
                 .alphas
@@ -280,6 +292,12 @@ impl SweepRequest {
             }
         }
         Ok(())
+    }
+
+    /// Runs of the whole grid (every model at every point; a shard runs a part of them).
+    /// Call after [`SweepRequest::validate`], which bounds it.
+    pub fn grid_runs(&self) -> usize {
+        self.models.len() * self.alphas.len() * self.frictions.len() * self.freq_ratios.len()
     }
 
     /// Every (model, α, ρ, Ω/ω) of the grid (or of this request's shard), mass-spring
@@ -353,6 +371,7 @@ pub fn run_sweep(
                         duration_s: Some(s.duration_s),
                         dt_s: s.dt_s,
                         integrator: s.integrator.clone(),
+                        grid_runs: Some(req.grid_runs() as u64),
                     })
                 }
                 _ => Err(failure(format!(
@@ -449,5 +468,10 @@ mod tests {
         for bad in ["0/4", "5/4", "x/4", "3"] {
             assert!(parse_shard(bad).is_err(), "{bad}");
         }
+        // More shards than runs: some would be empty, and are refused before any run.
+        assert_eq!(req.grid_runs(), 36);
+        req.shard = Some((37, 37));
+        let e = req.validate().unwrap_err().to_string();
+        assert!(e.contains("--shard") && e.contains("N <= 36"), "{e}");
     }
 }

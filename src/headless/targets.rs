@@ -183,8 +183,8 @@ mod tests {
             runs_per_model: 300,
             threads: 2,
             wall_s: 5.0,
-            dda_cpu_s: 9.0,
-            exact_cpu_s: 1.0,
+            dda_run_time_s: 9.0,
+            exact_run_time_s: 1.0,
             failures: 0,
         };
         let m = Measured {

@@ -53,6 +53,11 @@ pub struct SweepRow {
     /// The DDA run's integrator (empty for the exact model).
     #[serde(default)]
     pub integrator: Option<String>,
+    /// Runs of the whole grid this row's sweep ran (or ran a shard of): the same in every
+    /// row of one sweep, so that `merge` can tell a shard that was not given (empty in
+    /// tables from before this column).
+    #[serde(default)]
+    pub grid_runs: Option<u64>,
 }
 
 /// The four metrics by name, in the paper's order.
@@ -65,7 +70,7 @@ pub const METRICS: [&str; 4] = [
 
 impl SweepRow {
     /// The columns of `sweep.csv`, in order.
-    pub const COLUMNS: [&'static str; 16] = [
+    pub const COLUMNS: [&'static str; 17] = [
         "model",
         "alpha",
         "friction",
@@ -82,11 +87,16 @@ impl SweepRow {
         "duration_s",
         "dt_s",
         "integrator",
+        "grid_runs",
     ];
 
-    /// The run columns, added last (tables from before them end at
-    /// `energy_residual_rel`).
+    /// The run columns, added after `energy_residual_rel` (tables from before them end
+    /// there).
     const RUN_COLUMNS: [&'static str; 4] = ["amplitude_g", "duration_s", "dt_s", "integrator"];
+
+    /// The last column, added after the run columns (tables from before it end at
+    /// `integrator`).
+    const GRID_COLUMN: &'static str = "grid_runs";
 
     /// The ranges a row must be in to be used: known model, α ∈ (0, 1), finite ρ ≥ 0,
     /// finite Ω/ω > 0, finite metrics ≥ 0, at least one step, finite wall time and energy
@@ -199,15 +209,17 @@ pub fn read_sweep_csv(path: &Path) -> Result<Vec<SweepRow>> {
         .iter()
         .map(str::to_string)
         .collect();
-    // Tables from before the run columns are read without them, and tables from before
-    // the damping column as undamped.
-    let without_run = || {
+    // Tables from before the grid column are read without it, those from before the
+    // run columns without them, and those from before the damping column as undamped.
+    let without_grid = || {
         SweepRow::COLUMNS
             .iter()
-            .filter(|c| !SweepRow::RUN_COLUMNS.contains(c))
+            .filter(|c| **c != SweepRow::GRID_COLUMN)
     };
+    let without_run = || without_grid().filter(|c| !SweepRow::RUN_COLUMNS.contains(c));
     let undamped = || without_run().filter(|c| **c != "damping");
     if header != SweepRow::COLUMNS
+        && !header.iter().eq(without_grid())
         && !header.iter().eq(without_run())
         && !header.iter().eq(undamped())
     {
@@ -322,6 +334,35 @@ pub fn common_run(rows: &[SweepRow]) -> std::result::Result<(), String> {
         same(&of_model, "integrator", |r| r.integrator.clone())?;
     }
     Ok(())
+}
+
+/// Checks that the rows (distinct grid points, see `merge`) are every run of their grid:
+/// all of a sweep's rows carry its grid's size, so a shard that was not given, or a shard
+/// whose runs failed, shows as rows missing. Rows without the column (older tables) are
+/// not checked.
+pub fn whole_grid(rows: &[SweepRow]) -> std::result::Result<(), String> {
+    let sizes: std::collections::BTreeSet<u64> = rows.iter().filter_map(|r| r.grid_runs).collect();
+    if sizes.len() > 1 {
+        return Err(format!(
+            "the rows come from grids of different sizes ({} runs): shards of one sweep share \
+             its --alpha, --friction and --freq-ratios",
+            sizes
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    match sizes.first() {
+        Some(&size) if rows.iter().all(|r| r.grid_runs.is_some()) && rows.len() as u64 != size => {
+            Err(format!(
+                "the inputs hold {} of the grid's {size} runs: a shard is missing (or some of \
+                 its runs failed); give every shard's sweep.csv",
+                rows.len()
+            ))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// " (ζ = 2 %)" for a damped sweep, "" for an undamped one: added to figure titles.
@@ -534,7 +575,29 @@ mod tests {
             duration_s: Some(100.0),
             dt_s: (model == "dda").then_some(1e-3),
             integrator: (model == "dda").then(|| "generalized-alpha:0.5".into()),
+            grid_runs: Some(2),
         }
+    }
+
+    /// Rows that are not their whole grid (a shard not given) are refused, as are rows
+    /// of grids of different sizes; older rows without the column are not judged.
+    #[test]
+    fn a_missing_shard_is_told() {
+        let rows = [row("mass-spring", 1.0, 1.0), row("dda", 1.0, 1.0)];
+        assert!(whole_grid(&rows).is_ok());
+        let half = |r: &SweepRow| SweepRow {
+            grid_runs: Some(4),
+            ..r.clone()
+        };
+        let e = whole_grid(&rows.iter().map(half).collect::<Vec<_>>()).unwrap_err();
+        assert!(e.contains("2 of the grid's 4 runs"), "{e}");
+        let mixed = [rows[0].clone(), half(&rows[1])];
+        assert!(whole_grid(&mixed).unwrap_err().contains("different sizes"));
+        let old = |r: &SweepRow| SweepRow {
+            grid_runs: None,
+            ..r.clone()
+        };
+        assert!(whole_grid(&[old(&rows[0])]).is_ok());
     }
 
     #[test]
@@ -594,7 +657,9 @@ mod tests {
         let header: Vec<&str> = SweepRow::COLUMNS
             .iter()
             .copied()
-            .filter(|c| *c != "damping" && !SweepRow::RUN_COLUMNS.contains(c))
+            .filter(|c| {
+                *c != "damping" && !SweepRow::RUN_COLUMNS.contains(c) && *c != SweepRow::GRID_COLUMN
+            })
             .collect();
         std::fs::write(
             &old,
@@ -608,6 +673,19 @@ mod tests {
         assert_eq!(rows.len(), 1);
         assert_eq!(rows[0].damping, 0.0);
         assert_eq!(rows[0].duration_s, None);
+        // A table from before the grid column reads without it (merge does not judge it).
+        let before_grid = dir.join("before-grid.csv");
+        let header = &SweepRow::COLUMNS[..SweepRow::COLUMNS.len() - 1];
+        std::fs::write(
+            &before_grid,
+            format!(
+                "{}\ndda,0.5,0.1,2.0,0,1.0,1.0,1.0,1.0,10,0.1,0.0,0.3,100,0.001,hht\n",
+                header.join(",")
+            ),
+        )
+        .unwrap();
+        let rows = read_sweep_csv(&before_grid).unwrap();
+        assert_eq!((rows[0].grid_runs, rows[0].duration_s), (None, Some(100.0)));
         let new = dir.join("new.csv");
         let mut damped = row("dda", 2.0, 1.0);
         damped.damping = 0.05;

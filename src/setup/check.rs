@@ -444,7 +444,9 @@ fn resolution(setup: &RunSetup, warnings: &mut Vec<String>) -> Result<()> {
                 "--dt",
                 format!(
                     "Δt = {dts} s is {per:.3} steps per {what} ({period:.4e} s): the motion \
-                     cannot be represented; use Δt <= {:.3e} s",
+                     cannot be represented below {MIN_STEPS_PER_PERIOD} steps a period (Δt <= \
+                     {:.3e} s is accepted, Δt <= {:.3e} s resolves it)",
+                    period / MIN_STEPS_PER_PERIOD,
                     period / WARN_STEPS_PER_PERIOD
                 ),
             ));
