@@ -607,6 +607,13 @@ fn cmd_sweep(args: SweepArgs) -> Result<()> {
                 count(rows.len(), "run"),
                 elapsed(start)
             ))?;
+            if total == 0 {
+                out(&format!(
+                    "note: the grid has {} (both models), fewer than the {n} shards: this \
+                     shard's table has only its header, and merge takes it as it is",
+                    count(req.grid_runs(), "run")
+                ))?;
+            }
         }
         None => {
             write_sweep_outputs(&rows, &args.out)?;
