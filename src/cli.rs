@@ -765,8 +765,8 @@ fn cmd_bench(args: BenchArgs) -> Result<()> {
         // Without the series the old plot stays beside a bench.json that has none: say
         // so rather than delete files a user may have kept on purpose.
         let stale: Vec<_> = ["scaling.csv", "scaling.png"]
-            .iter()
             .map(|f| dir.join(f))
+            .into_iter()
             .filter(|f| report.scaling.is_empty() && f.exists())
             .collect();
         if !stale.is_empty() {
