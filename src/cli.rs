@@ -1065,10 +1065,9 @@ fn cmd_render(args: RenderArgs) -> Result<()> {
     }
     let files: Vec<String> = info.files.iter().map(|f| f.display().to_string()).collect();
     out(&format!(
-        "wrote {} ({} frame{}, {}; simulated in {:.2} s, rendered in {:.2} s)",
+        "wrote {} ({}, {}; simulated in {:.2} s, rendered in {:.2} s)",
         files.join(", "),
-        info.frames,
-        if info.frames == 1 { "" } else { "s" },
+        count(info.frames, "frame"),
         info.adapter,
         info.simulate_s,
         info.render_s
