@@ -307,7 +307,7 @@ fn summarise(setup: &RunSetup, run: &ModelRun) -> BlockSummary {
         peak_base_accel_g: run.peaks.base_accel / STANDARD_GRAVITY,
         peak_ground_accel_g: setup.motion.peak_accel(setup.duration) / STANDARD_GRAVITY,
         steps: run.steps,
-        solver: run.solver_counts(),
+        solver: run.solver,
         energy_residual_rel: run.energy_residual_rel,
         input_work_j: run.input_work,
         friction_dissipated_j: run.friction_dissipated,

@@ -217,7 +217,7 @@ fn summarise(
         peak_roof_drift_m: p.drift_m,
         base_accel_peak_freq_hz: peak_freq,
         steps: run.steps,
-        solver: run.solver_counts(),
+        solver: run.solver,
         energy_residual_rel: run.energy_residual_rel,
         wall_time_s: run.wall_time_s,
         warnings,

@@ -160,7 +160,7 @@ pub fn run_setup(setup: &RunSetup) -> Result<RunOutcome> {
         ur_max_m: run.peaks.drift_m,
         residual_slip_m: run.residual_slip_m,
         steps: run.steps,
-        solver: run.solver_counts(),
+        solver: run.solver,
         energy_residual_rel: run.energy_residual_rel,
         input_work_j: run.input_work,
         friction_dissipated_j: run.friction_dissipated,

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use crate::Result;
 use crate::analytic::ExactResult;
-use crate::dda::{CutReasons, SolverParams};
+use crate::dda::{CutReasons, RunCounters, SolverParams};
 use crate::ground_motion::GroundMotion;
 use crate::limits::MAX_HISTORY_ROWS;
 use crate::model::Scene;
@@ -40,19 +40,11 @@ pub struct ModelRun {
     pub residual_slip_m: f64,
     /// Time steps (DDA) or propagation steps (mass-spring).
     pub steps: u64,
-    /// Open-close passes (DDA only).
-    pub passes: u64,
-    /// Δt cuts (DDA only).
-    pub cuts: u64,
-    /// What forced them.
-    pub cut_reasons: CutReasons,
-    /// Numeric factorisations of the system matrix (DDA only).
-    pub factorizations: u64,
+    /// The DDA solver's counters; `None` for an exact model, which has none.
+    pub solver: Option<SolverCounts>,
     /// Steps that ended with a sliding contact (DDA only; the exact model reports its
     /// slip phases through the slip history).
     pub sliding_steps: u64,
-    /// Largest penetration / structure size (DDA only).
-    pub max_penetration_ratio: f64,
     /// Energy residual relative to the energy that passed through the structure.
     pub energy_residual_rel: f64,
     /// Input work, J per m of thickness.
@@ -94,18 +86,20 @@ pub struct SolverCounts {
     pub max_penetration_ratio: f64,
 }
 
-impl ModelRun {
-    /// The solver's counters of a DDA run; `None` for an exact model, which has none.
-    pub fn solver_counts(&self) -> Option<SolverCounts> {
-        (self.model == ModelKind::Dda).then_some(SolverCounts {
-            open_close_passes: self.passes,
-            dt_cuts: self.cuts,
-            dt_cut_reasons: self.cut_reasons,
-            factorizations: self.factorizations,
-            max_penetration_ratio: self.max_penetration_ratio,
-        })
+impl SolverCounts {
+    /// The counters a DDA run reports, from the solver's totals.
+    pub fn of(counters: &RunCounters) -> Self {
+        Self {
+            open_close_passes: counters.passes,
+            dt_cuts: counters.cuts,
+            dt_cut_reasons: counters.cut_reasons,
+            factorizations: counters.factorizations,
+            max_penetration_ratio: counters.max_penetration_ratio,
+        }
     }
+}
 
+impl ModelRun {
     /// The warning a run's summary carries when its base lifted off at a corner (not for
     /// vertical shaking, whose lift-off is warned of before the run).
     pub fn lift_off_warning(&self, vertical: bool) -> Option<String> {
@@ -259,12 +253,8 @@ pub fn run_dda(setup: &RunSetup, scene: &Scene, params: SolverParams) -> Result<
         },
         residual_slip_m: last_slip,
         steps: counters.steps,
-        passes: counters.passes,
-        cuts: counters.cuts,
-        cut_reasons: counters.cut_reasons,
-        factorizations: counters.factorizations,
+        solver: Some(SolverCounts::of(&counters)),
         sliding_steps,
-        max_penetration_ratio: counters.max_penetration_ratio,
         energy_residual_rel: dda.energy_residual_relative(),
         input_work: energy.input_work,
         friction_dissipated: energy.friction_dissipated,
@@ -369,12 +359,8 @@ impl ModelRun {
             peaks,
             residual_slip_m,
             steps,
-            passes: 0,
-            cuts: 0,
-            cut_reasons: CutReasons::default(),
-            factorizations: 0,
+            solver: None,
             sliding_steps: 0,
-            max_penetration_ratio: 0.0,
             energy_residual_rel: energy.residual_rel,
             input_work: energy.input_work,
             friction_dissipated: energy.friction_dissipated,
