@@ -208,6 +208,59 @@ fn a_parameter_change_keeps_the_time_cursor() {
     assert!((shown.time - 1.5).abs() < 1e-9, "shows {}", shown.time);
 }
 
+/// Issue 16's window pass: a change while the run is still computing, with the cursor
+/// inside the part already computed, sent the cursor to 0 — the replaced run's frames,
+/// still arriving before the new run started, were taken for the new run's.
+#[test]
+fn a_change_during_a_computing_run_keeps_the_time_cursor() {
+    let mut state = AppState::default();
+    state.take_commands();
+    // Generation 1 has computed 3 s of 10 and goes on computing.
+    for m in synthetic(1, 10.0, 3.0) {
+        state.ingest(m);
+    }
+    state.seek(2.0);
+    state.controls.friction *= 2.0;
+    state.restart();
+    assert_eq!(state.resume_at, Some(2.0));
+    // Frames of generation 1 up to 4 s arrive before generation 2 starts, then its end.
+    let frames = synthetic(1, 10.0, 4.0).remove(1);
+    state.ingest(frames);
+    state.ingest(SimMessage::Finished {
+        generation: 1,
+        wall_time_s: 1.0,
+        replayed_models: 0,
+    });
+    assert_eq!(
+        state.resume_at,
+        Some(2.0),
+        "the old run's frames took the target"
+    );
+    // The new run starts and computes 1 s: the cursor waits at 2 s; past it, it shows 2 s.
+    let mut msgs = synthetic(2, 10.0, 1.0);
+    state.ingest(msgs.remove(0));
+    state.ingest(msgs.remove(0));
+    state.advance(0.1);
+    assert!(
+        (state.play_time - 2.0).abs() < 1e-9,
+        "cursor {}",
+        state.play_time
+    );
+    assert_eq!(state.resume_at, Some(2.0));
+    let SimMessage::Frames { frames, .. } = synthetic(2, 10.0, 2.5).remove(1) else {
+        panic!("the second message is the frames");
+    };
+    state.ingest(SimMessage::Frames {
+        generation: 2,
+        frames: frames[100..].to_vec(),
+        samples: vec![Default::default(); 2],
+        speed: 1.0,
+        extract_us: 1.0,
+    });
+    assert_eq!(state.resume_at, None);
+    assert!((state.current().unwrap().time - 2.0).abs() < 1e-9);
+}
+
 /// Issue 12, finding 7: ←/→ merged when pressed quickly, Shift did nothing, play at the end
 /// did nothing with loop off, a quick click on the rail was ignored.
 #[test]

@@ -448,6 +448,9 @@ pub struct AppState {
     /// After a parameter change: the time the cursor returns to once the new run has
     /// computed it.
     pub resume_at: Option<f64>,
+    /// A run was asked for and has not started yet: until it does, the frames and the end
+    /// of the run it replaces (still arriving) must not take `resume_at` for theirs.
+    awaiting_start: bool,
     /// Errors to show (bad file, solver stopped…).
     pub error: Option<String>,
     /// A short message (file saved…), with when it was posted.
@@ -493,6 +496,7 @@ impl AppState {
             speed: 1.0,
             looping: true,
             resume_at: None,
+            awaiting_start: false,
             error: None,
             status: None,
             export_dir: "slidebase-export".into(),
@@ -518,6 +522,7 @@ impl AppState {
         self.error = None;
         if self.timeline.generation > 0 {
             self.resume_at = Some(self.play_time);
+            self.awaiting_start = true;
         }
         self.outbox
             .push(SimCommand::Run(Box::new(self.controls.config())));
@@ -552,6 +557,7 @@ impl AppState {
                 first,
             } => {
                 let models = first.models.len();
+                self.awaiting_start = false;
                 self.timeline = Timeline {
                     generation,
                     labels,
@@ -586,6 +592,7 @@ impl AppState {
                 self.extract_us = extract_us;
                 self.handoff_us = 0.9 * self.handoff_us + 0.1 * t0.elapsed().as_secs_f64() * 1e6;
                 if let Some(t) = self.resume_at
+                    && !self.awaiting_start
                     && self.timeline.available() >= t.min(self.timeline.duration) - 1e-9
                 {
                     self.resume_at = None;
@@ -598,7 +605,9 @@ impl AppState {
             } if generation == self.timeline.generation => {
                 self.timeline.finished = true;
                 self.timeline.replayed_models = replayed_models;
-                self.resume_at = None;
+                if !self.awaiting_start {
+                    self.resume_at = None;
+                }
             }
             SimMessage::Failed { message, .. } => {
                 self.error = Some(message);
