@@ -7,7 +7,7 @@
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
-use slidebase::sim::{FrameSet, SimCommand, SimConfig, SimMessage};
+use slidebase::sim::{FrameSet, SimCommand, SimConfig, SimMessage, TimeLeft};
 use slidebase::ui::AppState;
 
 fn runs(commands: &[SimCommand]) -> Vec<SimConfig> {
@@ -79,6 +79,7 @@ fn synthetic(generation: u64, duration: f64, upto: f64) -> Vec<SimMessage> {
             frames: (1..=n).map(|k| frame(k as f64 * 0.01)).collect(),
             samples,
             speed: 10.0,
+            time_left: None,
             extract_us: 1.0,
         },
     ];
@@ -93,9 +94,14 @@ fn synthetic(generation: u64, duration: f64, upto: f64) -> Vec<SimMessage> {
 }
 
 fn with_run(duration: f64) -> AppState {
+    with_run_computed_to(duration, duration)
+}
+
+/// A state showing run 1 of `duration` computed up to `upto` (still computing if less).
+fn with_run_computed_to(duration: f64, upto: f64) -> AppState {
     let mut state = AppState::default();
     state.take_commands();
-    for m in synthetic(1, duration, duration) {
+    for m in synthetic(1, duration, upto) {
         state.ingest(m);
     }
     state
@@ -111,6 +117,18 @@ fn click_at(h: &Harness<'_, AppState>, pos: egui::Pos2) {
             modifiers: Default::default(),
         });
     }
+}
+
+/// Types `text` into the file field of a window showing a finished run, presses load,
+/// and returns the harness and the error shown (there must be one).
+fn load_through_the_field(text: &str) -> (Harness<'static, AppState>, String) {
+    let mut state = with_run(1.0);
+    state.path_input = text.into();
+    let mut h = harness(state, 1600.0, 900.0);
+    h.get_by_label("load").click();
+    h.run_steps(2);
+    let error = h.state().error.clone().expect("an error is shown");
+    (h, error)
 }
 
 /// Issue 12, finding 4: typing one letter in the path field restarted the run and sent a
@@ -201,6 +219,7 @@ fn a_parameter_change_keeps_the_time_cursor() {
             .unwrap(),
         samples: vec![Default::default(); 2],
         speed: 1.0,
+        time_left: None,
         extract_us: 1.0,
     });
     assert_eq!(state.resume_at, None);
@@ -213,12 +232,8 @@ fn a_parameter_change_keeps_the_time_cursor() {
 /// still arriving before the new run started, were taken for the new run's.
 #[test]
 fn a_change_during_a_computing_run_keeps_the_time_cursor() {
-    let mut state = AppState::default();
-    state.take_commands();
     // Generation 1 has computed 3 s of 10 and goes on computing.
-    for m in synthetic(1, 10.0, 3.0) {
-        state.ingest(m);
-    }
+    let mut state = with_run_computed_to(10.0, 3.0);
     state.seek(2.0);
     state.controls.friction *= 2.0;
     state.restart();
@@ -255,10 +270,43 @@ fn a_change_during_a_computing_run_keeps_the_time_cursor() {
         frames: frames[100..].to_vec(),
         samples: vec![Default::default(); 2],
         speed: 1.0,
+        time_left: None,
         extract_us: 1.0,
     });
     assert_eq!(state.resume_at, None);
     assert!((state.current().unwrap().time - 2.0).abs() < 1e-9);
+}
+
+/// Issue 16's window pass: on a long run the replay caught up with the computation and
+/// crawled at its pace while the speed box still said 1×; nothing said it was waiting.
+#[test]
+fn a_replay_held_by_a_slow_computation_says_so() {
+    let mut state = with_run_computed_to(10.0, 1.0);
+    // Computing at 10× real time: the replay at 1× does not wait, nothing is said.
+    state.advance(2.0);
+    assert!((state.play_time - 1.0).abs() < 1e-9);
+    assert_eq!(state.picture_note(), None);
+    // At 0.3× it waits, and says so.
+    state.ingest(SimMessage::Frames {
+        generation: 1,
+        frames: Vec::new(),
+        samples: vec![Default::default(); 2],
+        speed: 0.3,
+        time_left: Some(TimeLeft {
+            seconds: 200.0,
+            likely_more: false,
+        }),
+        extract_us: 1.0,
+    });
+    let note = state.picture_note().expect("a note");
+    assert!(
+        note.contains("waits for the computation (0.30× real time, the replay 1×)"),
+        "{note}"
+    );
+    assert_eq!(state.timeline.time_left.map(|t| t.seconds), Some(200.0));
+    // Paused, it is not waiting.
+    state.toggle_play();
+    assert_eq!(state.picture_note(), None);
 }
 
 /// Issue 12, finding 7: ←/→ merged when pressed quickly, Shift did nothing, play at the end
@@ -361,13 +409,8 @@ fn loading_a_bad_record_file_shows_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("quake.csv");
     std::fs::write(&path, "0,0\n0.01,0.2\n0.02,nan\n").unwrap();
-    let mut state = with_run(1.0);
-    state.path_input = path.display().to_string();
-    let mut h = harness(state, 1600.0, 900.0);
-    h.get_by_label("load").click();
-    h.run_steps(2);
+    let (mut h, error) = load_through_the_field(&path.display().to_string());
     let state = h.state_mut();
-    let error = state.error.clone().expect("an error is shown");
     assert!(
         error.contains("quake.csv:3") && error.contains("not finite"),
         "{error}"
@@ -381,6 +424,32 @@ fn loading_a_bad_record_file_shows_an_error() {
     state.load_path();
     assert_eq!(runs(&state.take_commands()).len(), 1);
     assert!(state.error.is_none());
+}
+
+/// Issue 16's window pass: "wall:20" typed into the file field and loaded said "No such
+/// file or directory", and the courses field silently turned 20 into 12. A scene's name
+/// loads the window's own choice, and a size the window does not run says why and what
+/// does.
+#[test]
+fn a_scene_name_loads_or_says_where_it_runs() {
+    let (mut h, error) = load_through_the_field("wall:20");
+    let state = h.state_mut();
+    assert!(
+        error.contains("the window runs 2 to 12 courses")
+            && error.contains("slidebase run --scene wall:20"),
+        "{error}"
+    );
+    assert!(runs(&state.take_commands()).is_empty());
+    state.path_input = "wall:8".into();
+    state.load_path();
+    let started = runs(&state.take_commands());
+    assert_eq!(started.len(), 1);
+    assert_eq!(started[0].scene, "wall:8");
+    assert!(state.error.is_none());
+    state.path_input = "frame:50".into();
+    state.load_path();
+    let error = state.error.clone().expect("an error is shown");
+    assert!(error.contains("up to frame:20"), "{error}");
 }
 
 /// Regression: the default view stopped itself at t ≈ 0.1 s (the old slider rounded the

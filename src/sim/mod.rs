@@ -22,7 +22,7 @@ use crate::dda::{Dda, Integrator};
 use crate::ground_motion::GroundMotion;
 use crate::model::Scene;
 use crate::model::bearing::Bearing;
-use crate::setup::{ExcitationSpec, Frequency, RunSetup, RunSpec, VerticalSpec};
+use crate::setup::{ExcitationSpec, Frequency, RemainingTime, RunSetup, RunSpec, VerticalSpec};
 
 /// The ground motion of a run.
 #[derive(Debug, Clone, PartialEq)]
@@ -510,6 +510,7 @@ pub fn run_to_messages(config: &SimConfig, until: f64) -> Result<Vec<SimMessage>
         frames,
         samples,
         speed: end / start.elapsed().as_secs_f64().max(1e-9),
+        time_left: None,
         extract_us: 0.0,
     });
     messages.push(SimMessage::Finished {
@@ -569,6 +570,26 @@ pub struct FrameSet {
     pub models: Vec<ModelFrame>,
 }
 
+/// The wall-clock time a computing run has still to go, as the command line's progress
+/// line estimates it (see [`RemainingTime`]): from the pace so far and how hard the ground
+/// still has to shake.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeLeft {
+    /// Seconds still to go.
+    pub seconds: f64,
+    /// The ground has still to shake much harder than it has so far: `seconds` is the
+    /// pace so far, which the run will likely exceed (not a bound).
+    pub likely_more: bool,
+}
+
+impl TimeLeft {
+    /// Wall-clock time a run must have taken before its time left is estimated, s: a
+    /// shorter run is over before an estimate would help.
+    pub const FIRST_AFTER_S: f64 = 2.0;
+    /// How often the estimate takes in the run's pace, s of wall-clock time.
+    pub const EVERY_S: f64 = 1.0;
+}
+
 /// Messages from the simulation thread. Each carries the generation of the run it belongs
 /// to, so that a UI can drop frames of a run it has already replaced.
 #[derive(Debug, Clone)]
@@ -600,6 +621,9 @@ pub enum SimMessage {
         samples: Vec<Samples>,
         /// Simulated seconds per wall-clock second so far.
         speed: f64,
+        /// The wall-clock time the run has still to go, once it has run long enough to
+        /// tell (see [`TimeLeft`]).
+        time_left: Option<TimeLeft>,
         /// Mean time to copy one frame set out of the solvers, µs.
         extract_us: f64,
     },
@@ -783,6 +807,46 @@ impl KeptModels {
     }
 }
 
+/// The time left of a run in the window: [`RemainingTime`] fed every [`TimeLeft::EVERY_S`]
+/// from [`TimeLeft::FIRST_AFTER_S`] on, timed from the first step (the set-up before it,
+/// seconds for a large wall settling under gravity, is no part of the pace).
+struct TimeLeftEstimate {
+    stepping_since: Instant,
+    next_observation_s: f64,
+    /// Built at the first observation: a short run never samples its motion.
+    remaining: Option<RemainingTime>,
+    last: Option<TimeLeft>,
+}
+
+impl TimeLeftEstimate {
+    fn new(stepping_since: Instant) -> Self {
+        Self {
+            stepping_since,
+            next_observation_s: TimeLeft::FIRST_AFTER_S,
+            remaining: None,
+            last: None,
+        }
+    }
+
+    /// The time left with the run at simulated time `t` (the last estimate between
+    /// observations).
+    fn observe(&mut self, run: &PreparedRun, t: f64) -> Option<TimeLeft> {
+        let elapsed_s = self.stepping_since.elapsed().as_secs_f64();
+        if elapsed_s < self.next_observation_s || t >= run.duration {
+            return self.last.filter(|_| t < run.duration);
+        }
+        self.next_observation_s = elapsed_s + TimeLeft::EVERY_S;
+        let remaining = self
+            .remaining
+            .get_or_insert_with(|| RemainingTime::new(&run.motion, run.duration));
+        self.last = remaining.observe(t, elapsed_s).map(|seconds| TimeLeft {
+            seconds,
+            likely_more: remaining.harder_shaking_ahead(t),
+        });
+        self.last
+    }
+}
+
 enum RunEnd {
     Finished,
     Failed,
@@ -817,6 +881,7 @@ fn run_one(
     let (mut copy_total, mut copies) = (0.0, 0u64);
     let mut next_frame = 1u64;
     let mut chunk = FrameChunk::new();
+    let mut time_left = TimeLeftEstimate::new(Instant::now());
     loop {
         // Commands first: a new run replaces this one at once.
         match commands.try_recv() {
@@ -854,6 +919,7 @@ fn run_one(
         let done = target >= run.duration - 1e-12;
         if done || last_send.elapsed() > Duration::from_millis(30) {
             let speed = target / start.elapsed().as_secs_f64().max(1e-9);
+            let left = time_left.observe(&run, target);
             let extract_us = 1e6 * copy_total / copies.max(1) as f64;
             let frames = std::mem::take(&mut batch);
             let fresh: Vec<Samples> = samples.iter_mut().map(std::mem::take).collect();
@@ -868,6 +934,7 @@ fn run_one(
                     frames,
                     samples: fresh,
                     speed,
+                    time_left: left,
                     extract_us,
                 })
                 .is_err()

@@ -3,7 +3,10 @@
 //! run in the background and keeps the time cursor; typing a path restarts nothing until
 //! "load" is pressed.
 
-use super::{AppState, Comparison, Exaggeration, LawChoice, RecordChoice, SceneChoice};
+use super::{
+    AppState, Comparison, Exaggeration, LawChoice, RecordChoice, SceneChoice, WINDOW_MAX_COURSES,
+    WINDOW_MAX_STOREYS,
+};
 use crate::dda::Integrator;
 use crate::render::{ColorBy, Follow};
 
@@ -67,12 +70,23 @@ impl AppState {
             .on_hover_text(format!("the structure simulated: {label}"));
         match &mut self.controls.scene {
             SceneChoice::Frame(n) => {
-                ui.add(egui::Slider::new(n, 1..=10).text("storeys"))
-                    .on_hover_text("how many storeys the generated frame has");
+                ui.add(egui::Slider::new(n, 1..=WINDOW_MAX_STOREYS).text("storeys"))
+                    .on_hover_text(format!(
+                        "how many storeys the generated frame has: 1 to {WINDOW_MAX_STOREYS} \
+                         here, where the replay keeps every frame of both models (the \
+                         command line runs up to frame:{}: slidebase run --scene frame:N)",
+                        crate::model::generated::MAX_FRAME_STOREYS
+                    ));
             }
             SceneChoice::Wall(n) => {
-                ui.add(egui::Slider::new(n, 2..=12).text("courses"))
-                    .on_hover_text("how many courses of blocks the wall has (about N² blocks)");
+                ui.add(egui::Slider::new(n, 2..=WINDOW_MAX_COURSES).text("courses"))
+                    .on_hover_text(format!(
+                        "how many courses of blocks the wall has (about N² blocks): 2 to \
+                         {WINDOW_MAX_COURSES} here, where the replay keeps every frame of both \
+                         models (the command line runs up to wall:{}: slidebase run --scene \
+                         wall:N)",
+                        crate::model::generated::MAX_WALL
+                    ));
             }
             _ => {}
         }
@@ -298,7 +312,7 @@ impl AppState {
                         .hint_text("record (AT2/CSV) or scene (TOML) file")
                         .desired_width((ui.available_width() - 50.0).max(80.0)),
                 )
-                .on_hover_text("type the path of a PEER .AT2 or two-column CSV record, or a TOML scene, then press load");
+                .on_hover_text("type the path of a PEER .AT2 or two-column CSV record, or a TOML scene, or a scene's name (wall:8, frame:4), then press load");
             self.widget_rects.insert("path", field.rect);
             let enter = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
             let load = ui

@@ -23,6 +23,7 @@ use crate::model::friction::Friction;
 use crate::render::{Camera, ColorBy, Fit, Layers};
 use crate::sim::{
     ExactOverlay, Excitation, FrameSet, MotionInfo, Samples, SimCommand, SimConfig, SimMessage,
+    TimeLeft,
 };
 
 pub use plots::{
@@ -64,6 +65,51 @@ impl SceneChoice {
         }
     }
 
+    /// The choice a built-in or generated scene's name (`wall:8`, `three-storey`) stands
+    /// for in the window; `None` for any other text (a file's path), an error in words
+    /// for a size the window does not run (see [`WINDOW_MAX_STOREYS`]).
+    pub fn from_name(name: &str) -> Option<std::result::Result<SceneChoice, String>> {
+        let fixed = [
+            SceneChoice::ThreeStorey,
+            SceneChoice::TwoBlock,
+            SceneChoice::Block,
+            SceneChoice::FrictionPendulum,
+        ];
+        if let Some(choice) = fixed.into_iter().find(|c| c.name() == name) {
+            return Some(Ok(choice));
+        }
+        let (kind, size) = name.split_once(':')?;
+        let (what, window_max, cli_max, choice): (_, u32, usize, fn(u32) -> SceneChoice) =
+            match kind {
+                "frame" => (
+                    "storeys",
+                    WINDOW_MAX_STOREYS,
+                    crate::model::generated::MAX_FRAME_STOREYS,
+                    SceneChoice::Frame,
+                ),
+                "wall" => (
+                    "courses",
+                    WINDOW_MAX_COURSES,
+                    crate::model::generated::MAX_WALL,
+                    SceneChoice::Wall,
+                ),
+                _ => return None,
+            };
+        let low = if kind == "wall" { 2 } else { 1 };
+        Some(match size.trim().parse::<u32>() {
+            Ok(n) if (low..=window_max).contains(&n) => Ok(choice(n)),
+            Ok(n) if n as usize <= cli_max && n >= low => Err(format!(
+                "{name}: the window runs {low} to {window_max} {what} (it keeps every frame of \
+                 both models for the replay); the command line runs up to {kind}:{cli_max}: \
+                 slidebase run --scene {name}"
+            )),
+            _ => Err(format!(
+                "{name}: give {low} to {window_max} {what} here (the command line: up to \
+                 {kind}:{cli_max})"
+            )),
+        })
+    }
+
     /// A label for people.
     pub fn label(&self) -> String {
         match self {
@@ -77,6 +123,13 @@ impl SceneChoice {
         }
     }
 }
+
+/// Most storeys of a generated frame in the window, and courses of a generated wall: the
+/// replay keeps every frame of both models (a 12-course wall under the 41 s of Kobe holds
+/// ~1.2 GB); the command line runs up to `frame:20` and `wall:40`.
+pub const WINDOW_MAX_STOREYS: u32 = 10;
+/// See [`WINDOW_MAX_STOREYS`].
+pub const WINDOW_MAX_COURSES: u32 = 12;
 
 /// The last component of a path (long paths are shown by their file name).
 pub fn file_name(path: &str) -> String {
@@ -303,6 +356,9 @@ pub struct Timeline {
     pub motion: MotionInfo,
     /// Simulated seconds per wall second.
     pub sim_speed: f64,
+    /// The wall-clock time the run has still to go, while it computes and once it has
+    /// run long enough to tell.
+    pub time_left: Option<TimeLeft>,
     /// The run reached its end.
     pub finished: bool,
     /// How many models were played back from the last run (nothing they depend on
@@ -567,6 +623,7 @@ impl AppState {
                     exact: exact.map(|e| *e),
                     motion: *motion,
                     sim_speed: 0.0,
+                    time_left: None,
                     finished: false,
                     replayed_models: 0,
                     config: Some(*config),
@@ -582,6 +639,7 @@ impl AppState {
                 frames,
                 mut samples,
                 speed,
+                time_left,
                 extract_us,
             } if generation == self.timeline.generation => {
                 self.timeline.frames.extend(frames);
@@ -589,6 +647,7 @@ impl AppState {
                     mine.append(new);
                 }
                 self.timeline.sim_speed = speed;
+                self.timeline.time_left = time_left;
                 self.extract_us = extract_us;
                 self.handoff_us = 0.9 * self.handoff_us + 0.1 * t0.elapsed().as_secs_f64() * 1e6;
                 if let Some(t) = self.resume_at
@@ -624,6 +683,29 @@ impl AppState {
 
     fn at_end(&self) -> bool {
         self.timeline.finished && self.play_time >= self.timeline.duration - 1e-9
+    }
+
+    /// A note for the picture's header: the time a changed run is being computed up to,
+    /// or that the replay waits for a computation slower than the playback (on a long run
+    /// it would otherwise look like slow motion).
+    pub fn picture_note(&self) -> Option<String> {
+        if let Some(t) = self.resume_at {
+            return Some(format!("computing up to {t:.2} s…"));
+        }
+        // Within a second of the computed front: frames arrive in batches (two a second
+        // on a software rasteriser), so a held replay is mostly a little behind the front.
+        let timeline = &self.timeline;
+        let held = self.playing
+            && !timeline.finished
+            && self.play_time >= timeline.available() - HELD_WITHIN_S
+            && timeline.sim_speed < self.speed;
+        held.then(|| {
+            format!(
+                "the replay waits for the computation ({} real time, the replay {}×)",
+                speed_words(timeline.sim_speed),
+                self.speed
+            )
+        })
     }
 
     /// Advances the playback clock by `wall_dt` seconds of wall time.
@@ -869,6 +951,19 @@ impl AppState {
             self.error = Some("type the path of an AT2/CSV record or a TOML scene first".into());
             return;
         }
+        // A scene's name rather than a file's: the window's own choice, or why not.
+        if !std::path::Path::new(&path).exists()
+            && let Some(choice) = SceneChoice::from_name(&path)
+        {
+            match choice {
+                Ok(choice) => {
+                    self.controls.scene = choice;
+                    self.restart();
+                }
+                Err(why) => self.error = Some(why),
+            }
+            return;
+        }
         if path.to_lowercase().ends_with(".toml") {
             match crate::model::Scene::load(std::path::Path::new(&path)) {
                 Ok(_) => {
@@ -956,4 +1051,17 @@ pub fn auto_exaggeration(timeline: &Timeline) -> f32 {
 /// panels' fills cost more than everything else drawn.
 pub fn unfilled_panel(style: &egui::Style) -> egui::Frame {
     egui::Frame::side_top_panel(style).fill(egui::Color32::TRANSPARENT)
+}
+
+/// How close to the computed front (simulated s) a playing replay that outruns the
+/// computation counts as held by it (see [`AppState::picture_note`]).
+const HELD_WITHIN_S: f64 = 1.0;
+
+/// A simulation speed for people: "0.31×", "12×" (two decimals below 10×).
+fn speed_words(speed: f64) -> String {
+    if speed < 10.0 {
+        format!("{:.2}×", speed)
+    } else {
+        format!("{speed:.0}×")
+    }
 }

@@ -529,9 +529,7 @@ pub fn inputs_of(state: &mut AppState) -> Option<SceneInputs> {
         close_ups: state.view.close_ups,
         slip_scale,
         slip_ranges,
-        note: state
-            .resume_at
-            .map(|t| format!("computing up to {t:.2} s…")),
+        note: state.picture_note(),
     })
 }
 

@@ -2,7 +2,8 @@
 //! whole width (a press anywhere moves the cursor there, dragging scrubs, the computed part
 //! is shaded), the time, speed and loop.
 
-use super::AppState;
+use super::{AppState, Timeline};
+use crate::sim::TimeLeft;
 
 /// Height of the rail, points.
 const RAIL_HEIGHT: f32 = 34.0;
@@ -55,16 +56,12 @@ impl AppState {
             // Right to left: the status, loop and speed keep their room at any width (a
             // fixed reservation clipped "computing 23.0 / 31.2 s"), the rail takes the rest.
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                let computed = self.timeline.available();
-                let total = self.timeline.duration;
-                let text = if self.timeline.finished {
-                    format!("run {total:.1} s")
-                } else {
-                    format!("computing {computed:.1} / {total:.1} s")
-                };
-                ui.label(text).on_hover_text(
+                ui.label(run_status(&self.timeline)).on_hover_text(
                     "how much of the run the simulation has computed (it runs ahead in the \
-                     background)",
+                     background) and, on a long run, the time it has still to go: from its \
+                     pace so far and how hard the ground still has to shake. Before a \
+                     record's strong motion the pace so far is all there is to go by, and the \
+                     strong motion likely takes longer: \"likely over\"",
                 );
                 ui.checkbox(&mut self.looping, "loop")
                     .on_hover_text("start again at the end");
@@ -122,8 +119,10 @@ impl AppState {
             egui::pos2(x_of(self.timeline.available()), track.max.y),
         );
         painter.rect_filled(computed, 3.0, visuals.widgets.inactive.bg_fill);
-        let played =
-            egui::Rect::from_min_max(track.min, egui::pos2(x_of(self.play_time), track.max.y));
+        // Up to what has been computed: a cursor waiting ahead of the computation (a
+        // changed run computing up to it) leaves the computed part visible.
+        let played_to = self.play_time.min(self.timeline.available());
+        let played = egui::Rect::from_min_max(track.min, egui::pos2(x_of(played_to), track.max.y));
         painter.rect_filled(played, 3.0, visuals.selection.bg_fill);
         // Ticks: every second if there is room, labels every 5 or 10 s.
         let px_per_s = rect.width() / total as f32;
@@ -167,5 +166,84 @@ impl AppState {
                 egui::Stroke::new(2.0, visuals.warn_fg_color),
             );
         }
+    }
+}
+
+/// The run's state at the right of the timeline: its length once finished; while it
+/// computes, how far it has come and, on a long run, the time it has still to go.
+pub fn run_status(timeline: &Timeline) -> String {
+    let total = timeline.duration;
+    if timeline.finished {
+        return format!("run {total:.1} s");
+    }
+    let computed = timeline.available();
+    match &timeline.time_left {
+        Some(left) => format!(
+            "computing {computed:.1} / {total:.1} s, {}",
+            time_left_words(left)
+        ),
+        None => format!("computing {computed:.1} / {total:.1} s"),
+    }
+}
+
+/// "about 3 min left"; "likely over 40 s left" while the ground has still to shake much
+/// harder than so far (the pace so far, which the strong motion likely exceeds).
+pub fn time_left_words(left: &TimeLeft) -> String {
+    let s = left.seconds.max(0.0);
+    if s < 0.5 {
+        return "under a second left".into();
+    }
+    let span = if s < 90.0 {
+        format!("{s:.0} s")
+    } else if s < 90.0 * 60.0 {
+        format!("{:.0} min", s / 60.0)
+    } else {
+        let minutes = (s / 60.0).round() as u64;
+        format!("{} h {:02} min", minutes / 60, minutes % 60)
+    };
+    if left.likely_more {
+        format!("likely over {span} left")
+    } else {
+        format!("about {span} left")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn left(seconds: f64, likely_more: bool) -> TimeLeft {
+        TimeLeft {
+            seconds,
+            likely_more,
+        }
+    }
+
+    #[test]
+    fn the_time_left_reads_in_seconds_minutes_and_hours() {
+        assert_eq!(time_left_words(&left(0.2, false)), "under a second left");
+        assert_eq!(time_left_words(&left(42.4, false)), "about 42 s left");
+        assert_eq!(time_left_words(&left(200.0, false)), "about 3 min left");
+        assert_eq!(
+            time_left_words(&left(200.0, true)),
+            "likely over 3 min left"
+        );
+        assert_eq!(
+            time_left_words(&left(7500.0, false)),
+            "about 2 h 05 min left"
+        );
+    }
+
+    #[test]
+    fn the_status_tells_how_far_and_how_long_to_go() {
+        let mut t = Timeline {
+            duration: 41.0,
+            ..Default::default()
+        };
+        assert_eq!(run_status(&t), "computing 0.0 / 41.0 s");
+        t.time_left = Some(left(500.0, false));
+        assert_eq!(run_status(&t), "computing 0.0 / 41.0 s, about 8 min left");
+        t.finished = true;
+        assert_eq!(run_status(&t), "run 41.0 s");
     }
 }
