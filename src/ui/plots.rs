@@ -343,10 +343,15 @@ impl PlotCache {
     }
 }
 
-/// A number with about three significant digits for tick labels (no "0.000000001").
+/// A number with about three significant digits for tick labels (no "0.000000001"):
+/// below 10⁻⁴ a step's ticks read "5e-10", "1.5e-6" (decimals would all read "0.000000").
 fn tick(value: f64, step: f64) -> String {
     if value.abs() < 1e-3 * step.abs() {
         return "0".into();
+    }
+    if step.abs() < 1e-4 {
+        let digits = (value.abs().log10().floor() - step.abs().log10().floor()).clamp(0.0, 6.0);
+        return crate::post::trim_mantissa(&format!("{value:.prec$e}", prec = digits as usize));
     }
     let decimals = (-(step.abs().log10().floor()) as i64).clamp(0, 6) as usize;
     format!("{value:.decimals$}")
@@ -724,4 +729,20 @@ pub fn write_plot_data(
         columns.push(c.points.iter().map(|p| p[1]).collect());
     }
     table(header, columns).write_csv(&dir.join("spectrum.csv"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick;
+
+    /// A wall's slip of 5e-10 m had every tick read "0.000000".
+    #[test]
+    fn tiny_ticks_read_in_scientific_notation() {
+        assert_eq!(tick(0.5, 0.5), "0.5");
+        assert_eq!(tick(0.0002, 0.0001), "0.0002");
+        assert_eq!(tick(1e-6, 5e-7), "1e-6");
+        assert_eq!(tick(1.5e-6, 5e-7), "1.5e-6");
+        assert_eq!(tick(-5e-10, 5e-10), "-5e-10");
+        assert_eq!(tick(1e-20, 5e-10), "0");
+    }
 }

@@ -77,6 +77,10 @@ pub struct SceneInputs {
     pub slip_ranges: Vec<[f32; 2]>,
     /// A note for the header ("computing up to 9.84 s…").
     pub note: Option<String>,
+    /// The unit the readouts give the drift in: mm, or µm for a structure as stiff as a
+    /// block wall, whose drift would read "+0.0 mm" (chosen once for the run so far, so
+    /// that it does not switch as the drift swings through zero).
+    pub drift_unit: DriftUnit,
 }
 
 /// Text colour over the (light) sky.
@@ -221,17 +225,18 @@ fn model_labels(
         let p = model.probes;
         let readout = if model.single_body {
             format!(
-                "block {:+.3} g   slip {:+.3} m",
-                p.base_accel / STANDARD_GRAVITY,
-                p.slip
+                "block {} g   slip {} m",
+                signed(p.base_accel / STANDARD_GRAVITY, 3),
+                signed(p.slip, 3)
             )
         } else {
             format!(
-                "roof {:+.3} g   base {:+.3} g   slip {:+.3} m   drift {:+.1} mm",
-                p.roof_accel / STANDARD_GRAVITY,
-                p.base_accel / STANDARD_GRAVITY,
-                p.slip,
-                p.drift * 1e3
+                "roof {} g   base {} g   slip {} m   drift {} {}",
+                signed(p.roof_accel / STANDARD_GRAVITY, 3),
+                signed(p.base_accel / STANDARD_GRAVITY, 3),
+                signed(p.slip, 3),
+                signed(p.drift * s.drift_unit.per_metre(), 1),
+                s.drift_unit.symbol()
             )
         };
         let g_readout = galley(ui, readout, small, INK, w - 16.0);
@@ -530,6 +535,15 @@ pub fn inputs_of(state: &mut AppState) -> Option<SceneInputs> {
         slip_scale,
         slip_ranges,
         note: state.picture_note(),
+        drift_unit: DriftUnit::for_peak(
+            (0..state.timeline.labels.len())
+                .map(|m| {
+                    state
+                        .timeline
+                        .peak(m, state.timeline.available(), |s| &s.drift)
+                })
+                .fold(0.0, f64::max),
+        ),
     })
 }
 
@@ -584,5 +598,63 @@ pub fn scene_ui(state: &mut AppState, ui: &mut egui::Ui) {
     }
     if response.double_clicked() {
         state.view.camera.fit();
+    }
+}
+
+/// The unit of the readouts' drift (see [`SceneInputs::drift_unit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DriftUnit {
+    /// Millimetres: a frame's drift.
+    Millimetre,
+    /// Micrometres: a block wall's, below 0.1 mm at its peak.
+    Micrometre,
+}
+
+impl DriftUnit {
+    /// The unit for a run whose largest drift so far is `peak_m` metres.
+    pub fn for_peak(peak_m: f64) -> Self {
+        if peak_m > 0.0 && peak_m < 1e-4 {
+            DriftUnit::Micrometre
+        } else {
+            DriftUnit::Millimetre
+        }
+    }
+
+    fn per_metre(self) -> f64 {
+        match self {
+            DriftUnit::Millimetre => 1e3,
+            DriftUnit::Micrometre => 1e6,
+        }
+    }
+
+    fn symbol(self) -> &'static str {
+        match self {
+            DriftUnit::Millimetre => "mm",
+            DriftUnit::Micrometre => "µm",
+        }
+    }
+}
+
+/// `value` with its sign and `decimals` decimals, a value that rounds to zero as "+0.000"
+/// (not "-0.000": a readout that flickers between −0 and +0 says nothing).
+pub fn signed(value: f64, decimals: usize) -> String {
+    let scale = 10f64.powi(decimals as i32);
+    let rounded = (value * scale).round() / scale;
+    let shown = if rounded == 0.0 { 0.0 } else { rounded };
+    format!("{shown:+.decimals$}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{DriftUnit, signed};
+
+    #[test]
+    fn readouts_have_no_negative_zero_and_a_wall_drifts_in_micrometres() {
+        assert_eq!(signed(-0.00004, 3), "+0.000");
+        assert_eq!(signed(-0.0006, 3), "-0.001");
+        assert_eq!(signed(0.25, 1), "+0.3");
+        assert_eq!(DriftUnit::for_peak(2.4e-6), DriftUnit::Micrometre);
+        assert_eq!(DriftUnit::for_peak(0.0148), DriftUnit::Millimetre);
+        assert_eq!(DriftUnit::for_peak(0.0), DriftUnit::Millimetre);
     }
 }
