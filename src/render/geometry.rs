@@ -630,7 +630,8 @@ fn draw_contact(p: &mut Painter<'_>, c: &ContactFrame, a: [f32; 2]) {
     let b = [a[0] - n[0] * len, a[1] - n[1] * len];
     p.spring(b, a, 4.0, 3, 2.0, color);
     if c.state == 1 {
-        let s = [a[0] - c.tangent[0] * len, a[1] - c.tangent[1] * len];
+        let t = [c.along_edge * c.tangent[0], c.along_edge * c.tangent[1]];
+        let s = [a[0] + t[0] * len, a[1] + t[1] * len];
         p.spring(s, a, 3.0, 2, 1.5, color);
     }
     let dot = 3.0 * mpp;

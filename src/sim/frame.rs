@@ -39,6 +39,10 @@ pub struct ContactFrame {
     pub rigid: [f32; 2],
     /// Unit tangent of the edge.
     pub tangent: [f32; 2],
+    /// Which way along `tangent` the edge lies from the contact point, +1 or −1: the
+    /// shear spring is drawn over the edge (at a wall's end a contact sits at the edge's
+    /// end, and a spring drawn the other way stood in the air outside the wall).
+    pub along_edge: f32,
     /// Normal force, N.
     pub normal_force: f32,
     /// 0 open, 1 locked, 2 sliding.
@@ -409,6 +413,7 @@ impl Extractor {
                         carry(vb, reference)
                     },
                     tangent: [c.tangent[0] as f32, c.tangent[1] as f32],
+                    along_edge: along_edge(dda, c),
                     normal_force: n as f32,
                     state: c.state.code(),
                 }
@@ -455,5 +460,21 @@ impl Extractor {
                 .collect(),
             probes,
         }
+    }
+}
+
+/// Which way along the contact's tangent its edge lies from the contact point (see
+/// [`ContactFrame::along_edge`]): towards the edge's middle.
+fn along_edge(dda: &Dda, c: &crate::dda::contact::Contact) -> f32 {
+    let edge = &dda.blocks()[c.key.edge_block].vertices;
+    let (a, b) = (edge[c.key.edge], edge[(c.key.edge + 1) % edge.len()]);
+    let to_middle = [
+        0.5 * (a[0] + b[0]) - c.point[0],
+        0.5 * (a[1] + b[1]) - c.point[1],
+    ];
+    if to_middle[0] * c.tangent[0] + to_middle[1] * c.tangent[1] >= 0.0 {
+        1.0
+    } else {
+        -1.0
     }
 }
