@@ -300,7 +300,7 @@ fn a_replay_held_by_a_slow_computation_says_so() {
     });
     let note = state.picture_note().expect("a note");
     assert!(
-        note.contains("waits for the computation (0.30× real time, the replay 1×)"),
+        note.contains("waits for the computation (0.30× real time)"),
         "{note}"
     );
     assert_eq!(state.timeline.time_left.map(|t| t.seconds), Some(200.0));

@@ -701,9 +701,8 @@ impl AppState {
             && timeline.sim_speed < self.speed;
         held.then(|| {
             format!(
-                "the replay waits for the computation ({} real time, the replay {}×)",
-                speed_words(timeline.sim_speed),
-                self.speed
+                "the replay waits for the computation ({} real time)",
+                speed_words(timeline.sim_speed)
             )
         })
     }
