@@ -582,14 +582,6 @@ pub struct TimeLeft {
     pub likely_more: bool,
 }
 
-impl TimeLeft {
-    /// Wall-clock time a run must have taken before its time left is estimated, s: a
-    /// shorter run is over before an estimate would help.
-    pub const FIRST_AFTER_S: f64 = 2.0;
-    /// How often the estimate takes in the run's pace, s of wall-clock time.
-    pub const EVERY_S: f64 = 1.0;
-}
-
 /// Messages from the simulation thread. Each carries the generation of the run it belongs
 /// to, so that a UI can drop frames of a run it has already replaced.
 #[derive(Debug, Clone)]
@@ -807,9 +799,10 @@ impl KeptModels {
     }
 }
 
-/// The time left of a run in the window: [`RemainingTime`] fed every [`TimeLeft::EVERY_S`]
-/// from [`TimeLeft::FIRST_AFTER_S`] on, timed from the first step (the set-up before it,
-/// seconds for a large wall settling under gravity, is no part of the pace).
+/// The time left of a run in the window: [`RemainingTime`] fed every
+/// [`TimeLeftEstimate::EVERY_S`] from [`TimeLeftEstimate::FIRST_AFTER_S`] on, timed from the
+/// first step (the set-up before it, seconds for a large wall settling under gravity, is no
+/// part of the pace).
 struct TimeLeftEstimate {
     stepping_since: Instant,
     next_observation_s: f64,
@@ -819,10 +812,16 @@ struct TimeLeftEstimate {
 }
 
 impl TimeLeftEstimate {
+    /// Wall-clock time a run must have taken before its time left is estimated, s: a
+    /// shorter run is over before an estimate would help.
+    const FIRST_AFTER_S: f64 = 2.0;
+    /// How often the estimate takes in the run's pace, s of wall-clock time.
+    const EVERY_S: f64 = 1.0;
+
     fn new(stepping_since: Instant) -> Self {
         Self {
             stepping_since,
-            next_observation_s: TimeLeft::FIRST_AFTER_S,
+            next_observation_s: Self::FIRST_AFTER_S,
             remaining: None,
             last: None,
         }
@@ -835,7 +834,7 @@ impl TimeLeftEstimate {
         if elapsed_s < self.next_observation_s || t >= run.duration {
             return self.last.filter(|_| t < run.duration);
         }
-        self.next_observation_s = elapsed_s + TimeLeft::EVERY_S;
+        self.next_observation_s = elapsed_s + Self::EVERY_S;
         let remaining = self
             .remaining
             .get_or_insert_with(|| RemainingTime::new(&run.motion, run.duration));

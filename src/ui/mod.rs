@@ -79,23 +79,25 @@ impl SceneChoice {
             return Some(Ok(choice));
         }
         let (kind, size) = name.split_once(':')?;
-        let (what, window_max, cli_max, choice): (_, u32, usize, fn(u32) -> SceneChoice) =
+        // What the size counts, the window's range of it, the command line's largest.
+        let (what, low, window_max, cli_max, choice): (_, u32, u32, usize, fn(u32) -> _) =
             match kind {
                 "frame" => (
                     "storeys",
+                    1,
                     WINDOW_MAX_STOREYS,
                     crate::model::generated::MAX_FRAME_STOREYS,
                     SceneChoice::Frame,
                 ),
                 "wall" => (
                     "courses",
+                    2,
                     WINDOW_MAX_COURSES,
                     crate::model::generated::MAX_WALL,
                     SceneChoice::Wall,
                 ),
                 _ => return None,
             };
-        let low = if kind == "wall" { 2 } else { 1 };
         Some(match size.trim().parse::<u32>() {
             Ok(n) if (low..=window_max).contains(&n) => Ok(choice(n)),
             Ok(n) if n as usize <= cli_max && n >= low => Err(format!(
