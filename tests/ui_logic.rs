@@ -8,7 +8,7 @@
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable as _;
 use slidebase::sim::{FrameSet, SimCommand, SimConfig, SimMessage, TimeLeft};
-use slidebase::ui::AppState;
+use slidebase::ui::{AppState, SceneChoice};
 
 fn runs(commands: &[SimCommand]) -> Vec<SimConfig> {
     commands
@@ -386,6 +386,25 @@ fn shortcuts_work_and_are_listed() {
             .take_requests()
             .contains(&slidebase::ui::ShellRequest::Quit)
     );
+}
+
+/// Issue 16's window pass: a 12-course wall came back as 6 courses (and was computed again
+/// from scratch at that size) after a look at another scene.
+#[test]
+fn a_generated_scene_keeps_its_size_when_picked_again() {
+    let mut state = with_run(1.0);
+    state.controls.scene = SceneChoice::Wall(10);
+    let mut h = harness(state, 1600.0, 900.0);
+    h.get_by_value("dry-stacked wall, 10 courses").click();
+    h.run_steps(2);
+    h.get_by_label("three-storey frame (paper Fig. 3)").click();
+    h.run_steps(2);
+    assert_eq!(h.state().controls.scene, SceneChoice::ThreeStorey);
+    h.get_by_value("three-storey frame (paper Fig. 3)").click();
+    h.run_steps(2);
+    h.get_by_label("dry-stacked wall (generated)").click();
+    h.run_steps(2);
+    assert_eq!(h.state().controls.scene, SceneChoice::Wall(10));
 }
 
 /// A lecture preset sets up its comparison: three friction coefficients side by side.

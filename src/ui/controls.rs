@@ -59,10 +59,11 @@ impl AppState {
                     .on_hover_text("Newmark's sliding block: one rigid block on the joint, the textbook starting point; its exact solution is in the plots");
                 ui.selectable_value(c, SceneChoice::FrictionPendulum, SceneChoice::FrictionPendulum.label())
                     .on_hover_text("a thin slider in a concave dish of radius 2 m: gravity pulls it back to the middle (period 2π√(R/g) = 2.8 s)");
-                let frame = if let SceneChoice::Frame(n) = c { *n } else { 5 };
+                let (storeys, courses) = self.generated_sizes;
+                let frame = if let SceneChoice::Frame(n) = c { *n } else { storeys };
                 ui.selectable_value(c, SceneChoice::Frame(frame), "frame of N storeys (generated)")
                     .on_hover_text("the paper's frame with any number of storeys");
-                let wall = if let SceneChoice::Wall(n) = c { *n } else { 6 };
+                let wall = if let SceneChoice::Wall(n) = c { *n } else { courses };
                 ui.selectable_value(c, SceneChoice::Wall(wall), "dry-stacked wall (generated)")
                     .on_hover_text("loose blocks stacked in running bond on a sliding slab: every touching pair can slide, open and close");
             })
@@ -88,6 +89,11 @@ impl AppState {
                         crate::model::generated::MAX_WALL
                     ));
             }
+            _ => {}
+        }
+        match self.controls.scene {
+            SceneChoice::Frame(n) => self.generated_sizes.0 = n,
+            SceneChoice::Wall(n) => self.generated_sizes.1 = n,
             _ => {}
         }
         let r = ui

@@ -509,6 +509,9 @@ pub struct AppState {
     /// A run was asked for and has not started yet: until it does, the frames and the end
     /// of the run it replaces (still arriving) must not take `resume_at` for theirs.
     awaiting_start: bool,
+    /// The generated frame's storeys and wall's courses last chosen: picking the scene
+    /// again after another one brings them back (a 12-course wall stays 12 courses).
+    generated_sizes: (u32, u32),
     /// Errors to show (bad file, solver stopped…).
     pub error: Option<String>,
     /// A short message (file saved…), with when it was posted.
@@ -555,6 +558,7 @@ impl AppState {
             looping: true,
             resume_at: None,
             awaiting_start: false,
+            generated_sizes: (5, 6),
             error: None,
             status: None,
             export_dir: "slidebase-export".into(),
