@@ -93,6 +93,22 @@ fn synthetic(generation: u64, duration: f64, upto: f64) -> Vec<SimMessage> {
     msgs
 }
 
+/// The frames of [`synthetic`]'s run after its first `skip`, as one message (what arrives
+/// once a run has been computed further than the frames already taken in).
+fn later_frames(generation: u64, duration: f64, upto: f64, skip: usize) -> SimMessage {
+    let SimMessage::Frames { frames, .. } = synthetic(generation, duration, upto).remove(1) else {
+        panic!("the second message is the frames");
+    };
+    SimMessage::Frames {
+        generation,
+        frames: frames[skip..].to_vec(),
+        samples: vec![Default::default(); 2],
+        speed: 1.0,
+        time_left: None,
+        extract_us: 1.0,
+    }
+}
+
 fn with_run(duration: f64) -> AppState {
     with_run_computed_to(duration, duration)
 }
@@ -208,20 +224,7 @@ fn a_parameter_change_keeps_the_time_cursor() {
     );
     assert_eq!(state.resume_at, Some(1.5));
     // Once it has been computed past 1.5 s, the frame of 1.5 s is shown.
-    state.ingest(SimMessage::Frames {
-        generation: 2,
-        frames: synthetic(2, 2.0, 2.0)
-            .into_iter()
-            .find_map(|m| match m {
-                SimMessage::Frames { frames, .. } => Some(frames[50..].to_vec()),
-                _ => None,
-            })
-            .unwrap(),
-        samples: vec![Default::default(); 2],
-        speed: 1.0,
-        time_left: None,
-        extract_us: 1.0,
-    });
+    state.ingest(later_frames(2, 2.0, 2.0, 50));
     assert_eq!(state.resume_at, None);
     let shown = state.current().unwrap();
     assert!((shown.time - 1.5).abs() < 1e-9, "shows {}", shown.time);
@@ -262,17 +265,7 @@ fn a_change_during_a_computing_run_keeps_the_time_cursor() {
         state.play_time
     );
     assert_eq!(state.resume_at, Some(2.0));
-    let SimMessage::Frames { frames, .. } = synthetic(2, 10.0, 2.5).remove(1) else {
-        panic!("the second message is the frames");
-    };
-    state.ingest(SimMessage::Frames {
-        generation: 2,
-        frames: frames[100..].to_vec(),
-        samples: vec![Default::default(); 2],
-        speed: 1.0,
-        time_left: None,
-        extract_us: 1.0,
-    });
+    state.ingest(later_frames(2, 10.0, 2.5, 100));
     assert_eq!(state.resume_at, None);
     assert!((state.current().unwrap().time - 2.0).abs() < 1e-9);
 }

@@ -404,6 +404,14 @@ impl Timeline {
         self.config.as_ref().map_or(0.01, |c| c.frame_dt)
     }
 
+    /// The largest |drift| of any model computed so far, m (what the automatic
+    /// exaggeration and the readouts' drift unit are chosen from).
+    pub fn peak_drift(&self) -> f64 {
+        (0..self.samples.len())
+            .map(|m| self.peak(m, f64::INFINITY, |s| &s.drift))
+            .fold(0.0, f64::max)
+    }
+
     /// Largest |value| of a sample column of model `m` up to time `t`.
     pub fn peak(&self, m: usize, t: f64, column: fn(&Samples) -> &Vec<f64>) -> f64 {
         self.samples.get(m).map_or(0.0, |s| {
@@ -1035,9 +1043,7 @@ pub fn auto_exaggeration(timeline: &Timeline) -> f32 {
                 .fold(0.0f32, f32::max)
         })
         .max(0.1);
-    let drift = (0..timeline.samples.len())
-        .map(|m| timeline.peak(m, f64::INFINITY, |s| &s.drift))
-        .fold(0.0f64, f64::max) as f32;
+    let drift = timeline.peak_drift() as f32;
     if drift.is_nan() || drift <= 0.0 {
         return 50.0;
     }

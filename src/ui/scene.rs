@@ -535,15 +535,7 @@ pub fn inputs_of(state: &mut AppState) -> Option<SceneInputs> {
         slip_scale,
         slip_ranges,
         note: state.picture_note(),
-        drift_unit: DriftUnit::for_peak(
-            (0..state.timeline.labels.len())
-                .map(|m| {
-                    state
-                        .timeline
-                        .peak(m, state.timeline.available(), |s| &s.drift)
-                })
-                .fold(0.0, f64::max),
-        ),
+        drift_unit: DriftUnit::for_peak(state.timeline.peak_drift()),
     })
 }
 
